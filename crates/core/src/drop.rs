@@ -1,0 +1,255 @@
+//! One drop, end to end: release, integrate through every located mode switch, stop at the
+//! duration or when the whirl stopping rule decides, and audit the energy.
+
+use crate::error::{InvalidParameter, SolveError};
+use crate::model::{ix, DropSystem, Mode, Slip, N};
+use crate::monitor::{Features, Monitor};
+use crate::ode::{integrate, Dopri5, Stats, StepControl, Stop};
+use crate::orbit::Orbit;
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+
+/// Version of the model and its outputs; part of every record key. Bump it when a change
+/// alters results for the same scene.
+pub const MODEL_VERSION: u32 = 1;
+
+/// How to run a drop (what is not physics).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DropOptions {
+    /// Simulated time after release (s). Default 1. Allowed (0, 3600].
+    pub duration_s: f64,
+    /// Contact episodes separated by less than this count as one impact (s). Default 0.5 ms
+    /// (MODEL-NOTES: the light race can leave the rotor for a fraction of a millisecond
+    /// inside one impact).
+    pub impact_merge_s: f64,
+    /// Record the orbit with about this many samples (`None`: O(1) memory, no orbit).
+    pub orbit_points: Option<usize>,
+}
+
+impl Default for DropOptions {
+    fn default() -> Self {
+        Self {
+            duration_s: 1.0,
+            impact_merge_s: 0.5e-3,
+            orbit_points: None,
+        }
+    }
+}
+
+impl DropOptions {
+    /// Checks the options; the error names the field.
+    pub fn validate(&self) -> Result<(), InvalidParameter> {
+        if !(self.duration_s.is_finite() && self.duration_s > 0.0 && self.duration_s <= 3600.0) {
+            return Err(InvalidParameter::new(
+                "duration_s",
+                self.duration_s,
+                "(0, 3600] s",
+            ));
+        }
+        if !(self.impact_merge_s.is_finite() && self.impact_merge_s >= 0.0) {
+            return Err(InvalidParameter::new(
+                "impact_merge_s",
+                self.impact_merge_s,
+                ">= 0 s",
+            ));
+        }
+        if self.orbit_points == Some(0) || self.orbit_points.is_some_and(|n| n > 10_000_000) {
+            return Err(InvalidParameter::new(
+                "orbit_points",
+                self.orbit_points.unwrap_or(0),
+                "[1, 1e7]",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Why a drop ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopReason {
+    /// The requested duration was simulated.
+    DurationReached,
+    /// The contact point completed `whirl_stop_turns` net turns: whirl is decided, and in a
+    /// rigid housing it would only grow.
+    WhirlTurnsReached,
+}
+
+/// The energy audit: initial = final + friction heat + damping loss + drag work.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EnergyAudit {
+    /// Mechanical energy at release (J): kinetic, gravitational (zero at y = 0), elastic.
+    pub initial_j: f64,
+    /// Mechanical energy at the end (J).
+    pub final_j: f64,
+    /// Friction heat at the rotor-race contact, the integral of H_s (J).
+    pub friction_heat_j: f64,
+    /// Energy taken by the two contact dampers (J), including the elastic energy a contact
+    /// holds when its damper-never-pulls switch opens it while still overlapping (and, with
+    /// opposite sign, when it re-seats while overlapping).
+    pub damping_loss_j: f64,
+    /// Work of the Palmgren drag torque (J): the bearing's heat.
+    pub drag_work_j: f64,
+    /// |initial - final - losses| / scale, with scale the largest of |initial|, |final|, the
+    /// total loss and the drop energy m_r g s.
+    pub residual_rel: f64,
+}
+
+/// Everything one drop produced.
+#[derive(Debug, Clone)]
+pub struct DropReport {
+    /// Streamed measurements (peaks, impacts, whirl, window statistics).
+    pub features: Features,
+    /// The energy audit.
+    pub energy: EnergyAudit,
+    /// Integrator work counters.
+    pub stats: Stats,
+    /// Simulated time reached (s).
+    pub end_time_s: f64,
+    /// Why the run ended.
+    pub stop_reason: StopReason,
+    /// The orbit, when asked for.
+    pub orbit: Option<Orbit>,
+    /// Stable hash of the scene (16 hex digits).
+    pub scene_hash: String,
+}
+
+/// Per-component absolute tolerances: displacements to `rtol * position_scale_m`, speeds and
+/// energies to scales of the problem (impact speed sqrt(2 g s), spin, drop energy).
+fn tolerances(scene: &Scene, sys: &DropSystem) -> StepControl<N> {
+    let s = &scene.solver;
+    let rtol = s.rtol;
+    let pos = rtol * s.position_scale_m;
+    let v_ref = (2.0 * scene.gravity_m_s2.max(1.0) * scene.clearance_m).sqrt();
+    let vel = rtol * v_ref * 1e-2;
+    let ang = rtol * 1e-3;
+    let w = rtol * 1e-2;
+    let en = rtol * (sys.weight_n() * scene.clearance_m).max(1e-9) * 1e-2;
+    let mut atol = [0.0; N];
+    for i in [ix::XR, ix::YR, ix::XB, ix::YB] {
+        atol[i] = pos;
+    }
+    for i in [ix::TR, ix::TB] {
+        atol[i] = ang;
+    }
+    for i in [ix::VXR, ix::VYR, ix::VXB, ix::VYB] {
+        atol[i] = vel;
+    }
+    for i in [ix::WR, ix::WB] {
+        atol[i] = w;
+    }
+    for i in [ix::E_FRIC, ix::E_DAMP, ix::E_DRAG] {
+        atol[i] = en;
+    }
+    StepControl {
+        rtol,
+        atol,
+        h_min: s.min_step_s,
+        max_attempts: s.max_step_attempts,
+        fixed_step: None,
+    }
+}
+
+/// The mode after guard `index` fired at state `y` (see [`DropSystem`]'s guards).
+fn next_mode(sys: &DropSystem, y: &[f64; N], index: usize) -> Mode {
+    let mut m = sys.mode;
+    match index {
+        0 => {
+            m.contact = !m.contact;
+            if m.contact {
+                m.slip = sys.entering_slip(y, false);
+            }
+        }
+        1 => m.support = !m.support,
+        _ => {
+            m.slip = match m.slip {
+                Slip::Slipping(_) => sys.entering_slip(y, true),
+                Slip::Sticking => {
+                    let req = sys.forces(y).friction_required_n;
+                    Slip::Slipping(if req >= 0.0 { 1.0 } else { -1.0 })
+                }
+            }
+        }
+    }
+    m
+}
+
+/// Simulates one drop of `scene` under `opts`.
+pub fn simulate(scene: &Scene, opts: &DropOptions) -> Result<DropReport, SolveError> {
+    scene.validate()?;
+    opts.validate()?;
+    let mut sys = DropSystem::new(scene);
+    let mut y = sys.initial_state(scene.spin_rad_s());
+    let e0 = sys.mechanical_energy(&y, sys.mode);
+    let mut stepper = Dopri5::new(tolerances(scene, &sys));
+    let mut mon = Monitor::new(
+        opts.duration_s,
+        opts.impact_merge_s,
+        scene.spin_rad_s(),
+        scene.clearance_m,
+        scene.whirl_stop_turns,
+        opts.orbit_points,
+    );
+    mon.start(&sys, &y);
+    let mut t = 0.0;
+    let mut switch_loss = 0.0;
+    let stop_reason = loop {
+        match integrate(
+            &sys,
+            &mut stepper,
+            &mut t,
+            &mut y,
+            opts.duration_s,
+            &mut mon,
+        )? {
+            Stop::EndTime => break StopReason::DurationReached,
+            Stop::Observer => break StopReason::WhirlTurnsReached,
+            Stop::Event { index } => {
+                if stepper.stats.events >= scene.solver.max_events {
+                    return Err(SolveError::EventBudget {
+                        t_s: t,
+                        events: stepper.stats.events,
+                    });
+                }
+                let old = sys.mode;
+                let new = next_mode(&sys, &y, index);
+                switch_loss += sys.mechanical_energy(&y, old) - sys.mechanical_energy(&y, new);
+                if old.contact != new.contact {
+                    mon.contact_switch(t, new.contact);
+                }
+                sys.mode = new;
+                mon.mode_switched();
+            }
+        }
+    };
+    if y.iter().any(|v| !v.is_finite()) {
+        return Err(SolveError::NonFiniteState { t_s: t });
+    }
+    let e1 = sys.mechanical_energy(&y, sys.mode);
+    let (fric, damp, drag) = (y[ix::E_FRIC], y[ix::E_DAMP] + switch_loss, y[ix::E_DRAG]);
+    let losses = fric + damp + drag;
+    let scale = e0
+        .abs()
+        .max(e1.abs())
+        .max(losses.abs())
+        .max(sys.weight_n() * scene.clearance_m);
+    let energy = EnergyAudit {
+        initial_j: e0,
+        final_j: e1,
+        friction_heat_j: fric,
+        damping_loss_j: damp,
+        drag_work_j: drag,
+        residual_rel: (e0 - e1 - losses).abs() / scale,
+    };
+    let (features, orbit) = mon.finish(&sys, t, &y);
+    Ok(DropReport {
+        features,
+        energy,
+        stats: stepper.stats,
+        end_time_s: t,
+        stop_reason,
+        orbit,
+        scene_hash: scene.hash_hex(),
+    })
+}

@@ -1,0 +1,54 @@
+//! # whirlmap-core: the touchdown-bearing drop model and its integrator
+//!
+//! A rotor falls out of its active magnetic bearings onto a touchdown ball bearing. This
+//! crate simulates that drop as in the seed paper (eqs. 1-13 and 17), with the open points
+//! resolved as in MODEL-NOTES. No threads, no files, no plotting: a sweep crate fans it out
+//! and draws the charts.
+//!
+//! ## State
+//! Fifteen numbers (see [`model::ix`]): rotor geometric centre and angle `(x_r, y_r,
+//! theta_r)`, race centre and angle `(x_b, y_b, theta_b)`, their six rates, and three energy
+//! accumulators (friction heat, damper loss, drag work) integrated alongside so the energy
+//! audit sees the same error control.
+//!
+//! ## Equations
+//! - Rotor, eqs. 1-3, with unbalance solved exactly from Lagrange's equations
+//!   ([`model::DropSystem`]); race, eqs. 4-6, with Newton's third law at the contact.
+//! - Rotor-race contact, eq. 7 (`k1 = 1.988e9 N/m^(10/9)`, `c1 = 1000 N s/m`), and the race on
+//!   a lumped isotropic ball support (`k2 = 7.811e9 N/m^1.5`, `c2 = 750 N s/m`); a damper never
+//!   pulls ([`model::hertz`]).
+//! - Coulomb friction, eq. 8, with the stick/slip switch of eqs. 9-10 as located events
+//!   ([`model::friction`]); a regularised law is an option.
+//! - Palmgren drag on the race, eqs. 11-13 ([`model::drag`]).
+//! - Heat: `H_s = F_t v_rel` (eq. 17) and the bearing drag power `M |omega_b|`.
+//!
+//! ## Integrator
+//! [`ode`]: Dormand-Prince 5(4) with dense output; contact onset and loss, support release,
+//! slip reversal and stick break-away are guard crossings located on the interpolant; the
+//! step is capped in free flight; force and power peaks are located on the interpolant by
+//! the [`monitor::Monitor`] observer. Errors are typed and carry the time ([`SolveError`]).
+//!
+//! ## One drop
+//! ```
+//! use whirlmap_core::{simulate, DropOptions, Scene};
+//! let mut scene = Scene::paper();
+//! scene.speed_rpm = 8000.0;
+//! scene.mu_dynamic = 0.1;
+//! let report = simulate(&scene, &DropOptions { duration_s: 0.02, ..Default::default() }).unwrap();
+//! assert!(report.features.first_contact_force_n > 0.0);
+//! assert!(report.energy.residual_rel < 1e-6);
+//! ```
+#![warn(missing_docs)]
+
+pub mod drop;
+pub mod error;
+pub mod model;
+pub mod monitor;
+pub mod ode;
+pub mod orbit;
+pub mod scene;
+
+pub use drop::{simulate, DropOptions, DropReport, EnergyAudit, StopReason, MODEL_VERSION};
+pub use error::{InvalidParameter, SolveError};
+pub use monitor::{Features, Window};
+pub use scene::{FrictionLaw, Scene, SolverSettings};

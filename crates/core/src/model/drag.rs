@@ -1,0 +1,111 @@
+//! Palmgren's drag torque of the touchdown ball bearing, eqs. 11-13 (with eq. 31's M_1 form
+//! when a thermal load is added later). Catalogue units are converted here and only here:
+//! M in N mm, d_m in mm, nu0 in mm^2/s, n in r/min, P1 and C0 in N.
+
+/// Palmgren parameters in catalogue units, prepared once from a scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Palmgren {
+    /// f0: bearing type and lubrication factor.
+    pub f0: f64,
+    /// nu0: lubricant kinematic viscosity (mm^2/s).
+    pub nu0_mm2_s: f64,
+    /// d_m: pitch diameter (mm).
+    pub dm_mm: f64,
+    /// C0: basic static load rating (N).
+    pub c0_n: f64,
+}
+
+/// rad/s to r/min.
+const RAD_S_TO_RPM: f64 = 30.0 / std::f64::consts::PI;
+
+impl Palmgren {
+    /// Viscous part M_0 (N m), eq. 12, at race speed `omega_rad_s`.
+    ///
+    /// Eq. 12 switches at `nu0 n = 2000`, where its branches differ by 0.8 % (2000^(2/3) =
+    /// 158.7 against 160). We take the larger branch, `max((nu0 n)^(2/3), 160)`, which moves
+    /// the switch to `nu0 n = 2024` where the branches meet: the torque is then continuous,
+    /// and no integrator step straddles a jump. Differences stay below 0.8 % in that band.
+    #[inline]
+    pub fn viscous_torque_n_m(&self, omega_rad_s: f64) -> f64 {
+        let x = self.nu0_mm2_s * omega_rad_s.abs() * RAD_S_TO_RPM;
+        let c = x.cbrt();
+        let x23 = c * c;
+        1e-7 * self.f0 * x23.max(160.0) * self.dm_mm.powi(3) * 1e-3
+    }
+
+    /// Load part M_1 = f_1 P_1 d_m (N m), eq. 13, with f_1 = 0.001 (P_0 / C_0)^0.33 and
+    /// P_0 = P_1 = `load_n` (the instantaneous ball-support force; MODEL-NOTES).
+    #[inline]
+    pub fn load_torque_n_m(&self, load_n: f64) -> f64 {
+        let p = load_n.max(0.0);
+        if p == 0.0 {
+            return 0.0;
+        }
+        let f1 = 0.001 * (p / self.c0_n).powf(0.33);
+        f1 * p * self.dm_mm * 1e-3
+    }
+
+    /// Total drag torque magnitude M = M_0 + M_1 (N m), eq. 11.
+    #[inline]
+    pub fn torque_n_m(&self, omega_rad_s: f64, load_n: f64) -> f64 {
+        self.viscous_torque_n_m(omega_rad_s) + self.load_torque_n_m(load_n)
+    }
+}
+
+/// Direction factor of the drag torque: `tanh(omega / omega_eps)`. The drag opposes the race
+/// speed; at zero speed a Coulomb-like sign would chatter, so it fades to zero linearly within
+/// `omega_eps` (a documented scene parameter, default 0.1 rad/s, about 1 r/min).
+#[inline]
+pub fn direction(omega_rad_s: f64, omega_eps_rad_s: f64) -> f64 {
+    (omega_rad_s / omega_eps_rad_s).tanh()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bearing() -> Palmgren {
+        Palmgren {
+            f0: 2.0,
+            nu0_mm2_s: 22.0,
+            dm_mm: 51.0,
+            c0_n: 10_000.0,
+        }
+    }
+
+    #[test]
+    fn torque_matches_a_hand_computed_catalogue_example() {
+        // n = 5000 r/min, nu0 = 22 cSt: nu0 n = 110 000, (110 000)^(2/3) = 2295.77;
+        // M0 = 1e-7 * 2 * 2295.77 * 51^3 = 60.907 N mm.
+        // P1 = 500 N: f1 = 0.001 * 0.05^0.33 = 3.72100e-4; M1 = f1 * 500 * 51 = 9.4886 N mm.
+        let omega = 5000.0 / RAD_S_TO_RPM;
+        let m0 = bearing().viscous_torque_n_m(omega) * 1e3;
+        let m1 = bearing().load_torque_n_m(500.0) * 1e3;
+        assert!((m0 - 60.907).abs() < 0.005, "M0 = {m0} N mm");
+        assert!((m1 - 9.4886).abs() < 0.001, "M1 = {m1} N mm");
+        assert!((bearing().torque_n_m(-omega, 500.0) * 1e3 - 70.396).abs() < 0.006);
+    }
+
+    #[test]
+    fn low_speed_branch_is_the_constant_of_eq12_and_continuous() {
+        // nu0 n <= 2000: M0 = 160e-7 f0 d_m^3 = 4.2448 N mm, whatever the speed.
+        let b = bearing();
+        assert!((b.viscous_torque_n_m(0.0) * 1e3 - 4.24483).abs() < 1e-4);
+        assert!((b.viscous_torque_n_m(5.0) * 1e3 - 4.24483).abs() < 1e-4);
+        // Continuity where the branches meet (nu0 n = 160^1.5 = 2023.9).
+        let w = 160f64.powf(1.5) / 22.0 / RAD_S_TO_RPM;
+        let (a, c) = (
+            b.viscous_torque_n_m(w * (1.0 - 1e-9)),
+            b.viscous_torque_n_m(w * (1.0 + 1e-9)),
+        );
+        assert!((a - c).abs() / a < 1e-8);
+    }
+
+    #[test]
+    fn direction_is_odd_bounded_and_smooth_at_zero() {
+        assert_eq!(direction(0.0, 0.1), 0.0);
+        assert!((direction(10.0, 0.1) - 1.0).abs() < 1e-12);
+        assert!((direction(-10.0, 0.1) + 1.0).abs() < 1e-12);
+        assert!((direction(1e-4, 0.1) - 1e-3).abs() < 1e-8);
+    }
+}

@@ -1,0 +1,444 @@
+//! The rotor-race-support model of the paper's Sec. 2 as an [`OdeSystem`].
+//!
+//! Frame and signs (MODEL-NOTES): x horizontal, y up, gravity `-g` on both bodies,
+//! counter-clockwise angles positive. Contact geometry is relative: `d = O_r - O_b`,
+//! `n = d/|d|`, `t = (-n_y, n_x)`, contact angle `alpha = atan2(d_y, d_x)`, penetration
+//! `delta = |d| - s`. Slip velocity `v_rel = (v_r - v_b).t + omega_r r_r - omega_b R_b`
+//! (eq. 9's rolling condition is `v_rel = 0`). The rotor gets `-F_n n - F_t t` and the torque
+//! `-F_t r_r` (eqs. 1-3); the race gets `+F_n n + F_t t` and `+F_t R_b` (Newton's third law;
+//! printed eqs. 4-6 give the race friction the rotor's sign, read as a typo), plus the ball
+//! support force and the Palmgren drag torque.
+
+pub mod drag;
+pub mod friction;
+pub mod hertz;
+
+use crate::ode::{OdeSystem, MAX_GUARDS};
+use crate::scene::{FrictionLaw, Scene};
+pub use friction::Slip;
+
+/// State layout: rotor (x, y, theta), race (x, y, theta), their rates, then three energy
+/// accumulators integrated with the state so the energy audit sees the same error control.
+pub mod ix {
+    /// Rotor geometric centre x (m).
+    pub const XR: usize = 0;
+    /// Rotor geometric centre y (m).
+    pub const YR: usize = 1;
+    /// Rotor rotation angle (rad).
+    pub const TR: usize = 2;
+    /// Race centre x (m).
+    pub const XB: usize = 3;
+    /// Race centre y (m).
+    pub const YB: usize = 4;
+    /// Race rotation angle (rad).
+    pub const TB: usize = 5;
+    /// Rotor centre velocity x (m/s).
+    pub const VXR: usize = 6;
+    /// Rotor centre velocity y (m/s).
+    pub const VYR: usize = 7;
+    /// Rotor spin (rad/s).
+    pub const WR: usize = 8;
+    /// Race velocity x (m/s).
+    pub const VXB: usize = 9;
+    /// Race velocity y (m/s).
+    pub const VYB: usize = 10;
+    /// Race spin (rad/s).
+    pub const WB: usize = 11;
+    /// Friction heat at the rotor-race contact, integral of H_s = F_t v_rel (J), eq. 17.
+    pub const E_FRIC: usize = 12;
+    /// Energy dissipated by the two contact dampers (J).
+    pub const E_DAMP: usize = 13;
+    /// Work of the Palmgren drag torque, integral of M |omega_b| (J): the bearing's heat.
+    pub const E_DRAG: usize = 14;
+}
+/// State dimension.
+pub const N: usize = 15;
+
+/// The discrete mode: which contacts carry force and how the rotor-race contact rubs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mode {
+    /// Rotor-race contact active (eq. 7 force on).
+    pub contact: bool,
+    /// Race-on-balls support active (its damper never pulls either).
+    pub support: bool,
+    /// Friction state of the rotor-race contact while `contact`.
+    pub slip: Slip,
+}
+
+/// Everything the model computes at one state in one mode.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Forces {
+    /// Contact normal n (unit, from race centre towards rotor centre).
+    pub n: [f64; 2],
+    /// Contact tangent t = (-n_y, n_x).
+    pub t: [f64; 2],
+    /// |O_r - O_b| (m).
+    pub dist_m: f64,
+    /// Penetration delta = |d| - s (m).
+    pub delta_m: f64,
+    /// Penetration rate (m/s).
+    pub delta_dot_m_s: f64,
+    /// Slip velocity at the contact (m/s).
+    pub v_rel_m_s: f64,
+    /// Normal force F_n (N), eq. 7 (0 unless the contact is active).
+    pub normal_n: f64,
+    /// Eq. 7's force before the never-pull switch (N); continued to delta < 0 for guards.
+    pub normal_raw_n: f64,
+    /// Friction force F_t on the race along +t (N); the rotor gets its opposite.
+    pub friction_n: f64,
+    /// While sticking: the friction that keeps v_rel = 0 (N).
+    pub friction_required_n: f64,
+    /// Ball support force magnitude (N), pushing the race towards the housing centre.
+    pub support_n: f64,
+    /// Support force before the never-pull switch (N).
+    pub support_raw_n: f64,
+    /// Palmgren drag torque on the race (N m, signed, opposing omega_b).
+    pub drag_torque_n_m: f64,
+    /// H_s = F_t v_rel (W), eq. 17.
+    pub friction_power_w: f64,
+    /// Bearing drag power M |omega_b| (W): the bearing's share of eq. 14's H.
+    pub bearing_power_w: f64,
+    /// Damper power (W) of both contacts.
+    pub damping_power_w: f64,
+    /// Accelerations: rotor (x, y, theta), race (x, y, theta).
+    pub acc: [f64; 6],
+}
+
+/// The scene prepared for the right-hand side (SI, load share applied).
+#[derive(Debug, Clone)]
+pub struct DropSystem {
+    m_r: f64,
+    j_r: f64,
+    r_r: f64,
+    r_b: f64,
+    s: f64,
+    e: f64,
+    phase: f64,
+    m_b: f64,
+    j_b: f64,
+    g: f64,
+    k1: f64,
+    e1: f64,
+    c1: f64,
+    k2: f64,
+    e2: f64,
+    c2: f64,
+    mu_d: f64,
+    mu_s: f64,
+    law: FrictionLaw,
+    drag: Option<drag::Palmgren>,
+    omega_eps: f64,
+    free_max_step: f64,
+    f_ref: f64,
+    f_ref_b: f64,
+    /// The current mode; the driver switches it at located events.
+    pub mode: Mode,
+}
+
+impl DropSystem {
+    /// Prepares a validated scene.
+    pub fn new(scene: &Scene) -> Self {
+        let m_r = scene.rotor_mass_kg * scene.load_share;
+        let m_b = scene.race_mass_kg;
+        let g = scene.gravity_m_s2;
+        Self {
+            m_r,
+            j_r: scene.rotor_polar_moi_kg_m2 * scene.load_share,
+            r_r: scene.rotor_radius_m(),
+            r_b: scene.race_bore_radius_m(),
+            s: scene.clearance_m,
+            e: scene.unbalance_m,
+            phase: scene.unbalance_phase_rad,
+            m_b,
+            j_b: scene.race_polar_moi_kg_m2,
+            g,
+            k1: scene.contact_stiffness_n_per_m_e,
+            e1: scene.contact_exponent,
+            c1: scene.contact_damping_n_s_per_m,
+            k2: scene.support_stiffness_n_per_m_e,
+            e2: scene.support_exponent,
+            c2: scene.support_damping_n_s_per_m,
+            mu_d: scene.mu_dynamic,
+            mu_s: scene.mu_static(),
+            law: scene.friction_law,
+            drag: scene.drag_enabled.then_some(drag::Palmgren {
+                f0: scene.palmgren_f0,
+                nu0_mm2_s: scene.lubricant_viscosity_mm2_s,
+                dm_mm: scene.pitch_diameter_m * 1e3,
+                c0_n: scene.static_load_rating_n,
+            }),
+            omega_eps: scene.drag_zero_speed_rad_s,
+            free_max_step: scene.solver.free_flight_max_step_s,
+            f_ref: (m_r * g).max(1e-3),
+            f_ref_b: (m_b * g).max(1e-6),
+            mode: Mode {
+                contact: false,
+                support: true,
+                slip: Slip::Slipping(1.0),
+            },
+        }
+    }
+
+    /// The release state (MODEL-NOTES): rotor centre at the housing centre at rest with spin
+    /// Omega; race at rest at its static sag on the balls, `(m_b g / k2)^(1/e2)` below centre.
+    /// Also sets the initial mode (rotor free, race on its support).
+    pub fn initial_state(&mut self, spin_rad_s: f64) -> [f64; N] {
+        let mut y = [0.0; N];
+        y[ix::WR] = spin_rad_s;
+        y[ix::YB] = -(self.m_b * self.g / self.k2).powf(1.0 / self.e2);
+        self.mode = Mode {
+            contact: false,
+            support: self.g > 0.0,
+            slip: Slip::Slipping(1.0),
+        };
+        y
+    }
+
+    /// Rotor-race clearance s (m).
+    pub fn clearance_m(&self) -> f64 {
+        self.s
+    }
+
+    /// Whether the friction mode can switch (switched law with friction present).
+    fn friction_switches(&self) -> bool {
+        matches!(self.law, FrictionLaw::Switched) && self.mu_d > 0.0
+    }
+
+    /// Accelerations for given contact forces (eqs. 1-6 solved for the second derivatives).
+    ///
+    /// Rotor with unbalance: generalised coordinates are the geometric centre and the angle;
+    /// the mass centre is at `O_r + e (cos psi, sin psi)`, `psi = theta + phase`. Lagrange's
+    /// equations give eqs. 1-2 as printed and, eliminating the centre accelerations,
+    /// `J theta'' = tau + e (F_x sin psi - F_y cos psi)` with `tau = -F_t r_r` and `F` the
+    /// contact force on the rotor. Printed eq. 3 writes `- m g e cos theta` for the last term:
+    /// the same thing when the contact carries the weight (`F_y = m g`), which is the
+    /// approximation the paper made; we keep the exact form.
+    #[inline]
+    fn accelerations(&self, y: &[f64; N], f: &Forces, ft: f64, support_vec: [f64; 2]) -> [f64; 6] {
+        let (n, t) = (f.n, f.t);
+        let fx = -f.normal_n * n[0] - ft * t[0];
+        let fy = -f.normal_n * n[1] - ft * t[1];
+        let tau = -ft * self.r_r;
+        let (ax_r, ay_r, al_r);
+        if self.e == 0.0 {
+            al_r = tau / self.j_r;
+            ax_r = fx / self.m_r;
+            ay_r = fy / self.m_r - self.g;
+        } else {
+            let (sp, cp) = (y[ix::TR] + self.phase).sin_cos();
+            let w2 = y[ix::WR] * y[ix::WR];
+            al_r = (tau + self.e * (fx * sp - fy * cp)) / self.j_r;
+            ax_r = fx / self.m_r + self.e * (al_r * sp + w2 * cp);
+            ay_r = fy / self.m_r - self.g - self.e * (al_r * cp - w2 * sp);
+        }
+        let ax_b = (f.normal_n * n[0] + ft * t[0] + support_vec[0]) / self.m_b;
+        let ay_b = (f.normal_n * n[1] + ft * t[1] + support_vec[1]) / self.m_b - self.g;
+        let al_b = (ft * self.r_b + f.drag_torque_n_m) / self.j_b;
+        [ax_r, ay_r, al_r, ax_b, ay_b, al_b]
+    }
+
+    /// d(v_rel)/dt for given accelerations (differentiating eq. 9's slip velocity; the
+    /// tangent turns with the contact angle, `t' = -(v_t/|d|) n`).
+    #[inline]
+    fn slip_acceleration(&self, f: &Forces, v_t: f64, a: &[f64; 6]) -> f64 {
+        (a[0] - a[3]) * f.t[0] + (a[1] - a[4]) * f.t[1] - v_t * f.delta_dot_m_s / f.dist_m
+            + a[2] * self.r_r
+            - a[5] * self.r_b
+    }
+
+    /// All forces, powers and accelerations at `y` in the current mode.
+    pub fn forces(&self, y: &[f64; N]) -> Forces {
+        self.forces_in(y, self.mode)
+    }
+
+    /// All forces, powers and accelerations at `y` in mode `mode`.
+    pub fn forces_in(&self, y: &[f64; N], mode: Mode) -> Forces {
+        let mut f = Forces::default();
+        let dx = y[ix::XR] - y[ix::XB];
+        let dy = y[ix::YR] - y[ix::YB];
+        let dist = (dx * dx + dy * dy).sqrt();
+        f.dist_m = dist;
+        f.n = if dist > 0.0 {
+            [dx / dist, dy / dist]
+        } else {
+            [0.0, -1.0]
+        };
+        f.t = [-f.n[1], f.n[0]];
+        let dvx = y[ix::VXR] - y[ix::VXB];
+        let dvy = y[ix::VYR] - y[ix::VYB];
+        f.delta_m = dist - self.s;
+        f.delta_dot_m_s = dvx * f.n[0] + dvy * f.n[1];
+        let v_t = dvx * f.t[0] + dvy * f.t[1];
+        f.v_rel_m_s = v_t + y[ix::WR] * self.r_r - y[ix::WB] * self.r_b;
+        f.normal_raw_n = hertz::raw_force(self.k1, self.e1, self.c1, f.delta_m, f.delta_dot_m_s);
+        if mode.contact {
+            f.normal_n = f.normal_raw_n;
+        }
+
+        // Ball support: isotropic, zero clearance, eq. 7 with e = 3/2 and c2.
+        let (bx, by) = (y[ix::XB], y[ix::YB]);
+        let r = (bx * bx + by * by).sqrt();
+        let mut support_vec = [0.0; 2];
+        let mut r_dot = 0.0;
+        if r > 0.0 {
+            let nb = [bx / r, by / r];
+            r_dot = y[ix::VXB] * nb[0] + y[ix::VYB] * nb[1];
+            f.support_raw_n = hertz::raw_force(self.k2, self.e2, self.c2, r, r_dot);
+            if mode.support {
+                f.support_n = f.support_raw_n;
+                support_vec = [-f.support_n * nb[0], -f.support_n * nb[1]];
+            }
+        }
+
+        // Palmgren drag (eqs. 11-13) on the race, P1 = the support force.
+        let wb = y[ix::WB];
+        if let Some(p) = &self.drag {
+            let m = p.torque_n_m(wb, f.support_n);
+            let dir = drag::direction(wb, self.omega_eps);
+            f.drag_torque_n_m = -m * dir;
+            f.bearing_power_w = m * dir * wb;
+        }
+
+        // Friction, eq. 8, or the rolling constraint of eqs. 9-10 while sticking.
+        let ft = if !mode.contact {
+            0.0
+        } else {
+            match (self.law, mode.slip) {
+                (FrictionLaw::Regularised { v_eps_m_s }, _) => {
+                    self.mu_d * f.normal_n * (f.v_rel_m_s / v_eps_m_s).tanh()
+                }
+                (FrictionLaw::Switched, Slip::Slipping(sign)) => self.mu_d * f.normal_n * sign,
+                (FrictionLaw::Switched, Slip::Sticking) => {
+                    // v_rel' is affine in F_t: solve v_rel' = 0.
+                    let a0 = self.accelerations(y, &f, 0.0, support_vec);
+                    let a1 = self.accelerations(y, &f, 1.0, support_vec);
+                    let s0 = self.slip_acceleration(&f, v_t, &a0);
+                    let s1 = self.slip_acceleration(&f, v_t, &a1);
+                    -s0 / (s1 - s0)
+                }
+            }
+        };
+        if mode.contact && mode.slip == Slip::Sticking {
+            f.friction_required_n = ft;
+        }
+        f.friction_n = ft;
+        f.friction_power_w = ft * f.v_rel_m_s;
+        f.damping_power_w = if mode.contact {
+            self.c1 * f.delta_dot_m_s * f.delta_dot_m_s
+        } else {
+            0.0
+        } + if mode.support {
+            self.c2 * r_dot * r_dot
+        } else {
+            0.0
+        };
+        f.acc = self.accelerations(y, &f, ft, support_vec);
+        f
+    }
+
+    /// The friction mode to enter at a state in contact, per eqs. 9-10: slip along the slip
+    /// velocity's sign, unless it is (numerically) zero, in which case stick if the friction
+    /// that keeps rolling is at most `mu_s F_n`, else slip along that friction's sign.
+    /// `at_zero` forces the stick test (the state sits at a located v_rel = 0 crossing).
+    pub fn entering_slip(&self, y: &[f64; N], at_zero: bool) -> Slip {
+        if !self.friction_switches() {
+            return Slip::Slipping(1.0);
+        }
+        let mode = Mode {
+            contact: true,
+            support: self.mode.support,
+            slip: Slip::Sticking,
+        };
+        let f = self.forces_in(y, mode);
+        let v_scale = 1e-9 * (1.0 + y[ix::WR].abs() * self.r_r);
+        if !at_zero && f.v_rel_m_s.abs() > v_scale {
+            return Slip::Slipping(f.v_rel_m_s.signum());
+        }
+        friction::stick_or_slip(f.friction_required_n, self.mu_s * f.normal_n.max(0.0))
+    }
+
+    /// Mechanical energy (J): kinetic, gravitational (zero at y = 0) and the elastic energy
+    /// of the contacts active in `mode`.
+    pub fn mechanical_energy(&self, y: &[f64; N], mode: Mode) -> f64 {
+        let (mut vcx, mut vcy, mut yc) = (y[ix::VXR], y[ix::VYR], y[ix::YR]);
+        if self.e != 0.0 {
+            let (sp, cp) = (y[ix::TR] + self.phase).sin_cos();
+            vcx -= self.e * y[ix::WR] * sp;
+            vcy += self.e * y[ix::WR] * cp;
+            yc += self.e * sp;
+        }
+        let ke_r =
+            0.5 * self.m_r * (vcx * vcx + vcy * vcy) + 0.5 * self.j_r * y[ix::WR] * y[ix::WR];
+        let ke_b = 0.5 * self.m_b * (y[ix::VXB].powi(2) + y[ix::VYB].powi(2))
+            + 0.5 * self.j_b * y[ix::WB].powi(2);
+        let pe = self.g * (self.m_r * yc + self.m_b * y[ix::YB]);
+        let mut el = 0.0;
+        if mode.contact {
+            let dist = ((y[ix::XR] - y[ix::XB]).powi(2) + (y[ix::YR] - y[ix::YB]).powi(2)).sqrt();
+            el += hertz::elastic_energy(self.k1, self.e1, dist - self.s);
+        }
+        if mode.support {
+            let r = (y[ix::XB].powi(2) + y[ix::YB].powi(2)).sqrt();
+            el += hertz::elastic_energy(self.k2, self.e2, r);
+        }
+        ke_r + ke_b + pe + el
+    }
+
+    /// A force scale for energy and guard normalisation: the rotor's weight share (N).
+    pub fn weight_n(&self) -> f64 {
+        self.f_ref
+    }
+
+    /// Contact guard: `min(delta / s, F_raw / F_ref)`, positive exactly when eq. 7's force
+    /// is active (penetrating, and the damper not pulling). Continuous in the state.
+    #[inline]
+    fn contact_indicator(&self, f: &Forces) -> f64 {
+        (f.delta_m / self.s).min(f.normal_raw_n / self.f_ref)
+    }
+}
+
+impl OdeSystem<N> for DropSystem {
+    fn rhs(&self, _t: f64, y: &[f64; N], dy: &mut [f64; N]) {
+        let f = self.forces(y);
+        dy[ix::XR] = y[ix::VXR];
+        dy[ix::YR] = y[ix::VYR];
+        dy[ix::TR] = y[ix::WR];
+        dy[ix::XB] = y[ix::VXB];
+        dy[ix::YB] = y[ix::VYB];
+        dy[ix::TB] = y[ix::WB];
+        dy[ix::VXR..=ix::WB].copy_from_slice(&f.acc);
+        dy[ix::E_FRIC] = f.friction_power_w;
+        dy[ix::E_DAMP] = f.damping_power_w;
+        dy[ix::E_DRAG] = f.bearing_power_w;
+    }
+
+    /// Guards: 0 contact (onset when free, loss when in contact), 1 support (release or
+    /// re-seat), 2 friction (slip velocity reversal while slipping; friction demand above
+    /// `mu_s F_n` while sticking).
+    fn guards(&self, _t: f64, y: &[f64; N], g: &mut [f64; MAX_GUARDS]) -> usize {
+        let f = self.forces(y);
+        let c = self.contact_indicator(&f);
+        g[0] = if self.mode.contact { c } else { -c };
+        let sup = f.support_raw_n / self.f_ref_b;
+        g[1] = if self.mode.support { sup } else { -sup };
+        if self.mode.contact && self.friction_switches() {
+            g[2] = match self.mode.slip {
+                Slip::Slipping(sign) => sign * f.v_rel_m_s,
+                Slip::Sticking => {
+                    (self.mu_s * f.normal_n - f.friction_required_n.abs()) / self.f_ref
+                }
+            };
+            3
+        } else {
+            2
+        }
+    }
+
+    fn max_step(&self) -> f64 {
+        if self.mode.contact {
+            f64::INFINITY
+        } else {
+            self.free_max_step
+        }
+    }
+}

@@ -1,0 +1,471 @@
+//! Dormand-Prince 5(4) with Hairer's PI step control and 4th-order dense output.
+//!
+//! Coefficients: J. R. Dormand, P. J. Prince, "A family of embedded Runge-Kutta formulae",
+//! J. Comp. Appl. Math. 6 (1980); dense output and controller as in E. Hairer, S. P. Nørsett,
+//! G. Wanner, "Solving Ordinary Differential Equations I", 2nd ed., Sec. II.4-II.6 (DOPRI5).
+
+use super::{OdeSystem, Stats};
+use crate::error::SolveError;
+
+const C2: f64 = 1.0 / 5.0;
+const C3: f64 = 3.0 / 10.0;
+const C4: f64 = 4.0 / 5.0;
+const C5: f64 = 8.0 / 9.0;
+const A21: f64 = 1.0 / 5.0;
+const A31: f64 = 3.0 / 40.0;
+const A32: f64 = 9.0 / 40.0;
+const A41: f64 = 44.0 / 45.0;
+const A42: f64 = -56.0 / 15.0;
+const A43: f64 = 32.0 / 9.0;
+const A51: f64 = 19372.0 / 6561.0;
+const A52: f64 = -25360.0 / 2187.0;
+const A53: f64 = 64448.0 / 6561.0;
+const A54: f64 = -212.0 / 729.0;
+const A61: f64 = 9017.0 / 3168.0;
+const A62: f64 = -355.0 / 33.0;
+const A63: f64 = 46732.0 / 5247.0;
+const A64: f64 = 49.0 / 176.0;
+const A65: f64 = -5103.0 / 18656.0;
+const A71: f64 = 35.0 / 384.0;
+const A73: f64 = 500.0 / 1113.0;
+const A74: f64 = 125.0 / 192.0;
+const A75: f64 = -2187.0 / 6784.0;
+const A76: f64 = 11.0 / 84.0;
+const E1: f64 = 71.0 / 57600.0;
+const E3: f64 = -71.0 / 16695.0;
+const E4: f64 = 71.0 / 1920.0;
+const E5: f64 = -17253.0 / 339200.0;
+const E6: f64 = 22.0 / 525.0;
+const E7: f64 = -1.0 / 40.0;
+const D1: f64 = -12715105075.0 / 11282082432.0;
+const D3: f64 = 87487479700.0 / 32700410799.0;
+const D4: f64 = -10690763975.0 / 1880347072.0;
+const D5: f64 = 701980252875.0 / 199316789632.0;
+const D6: f64 = -1453857185.0 / 822651844.0;
+const D7: f64 = 69997945.0 / 29380423.0;
+
+/// Step-size control settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepControl<const N: usize> {
+    /// Relative tolerance (dimensionless).
+    pub rtol: f64,
+    /// Absolute tolerance per state component (in that component's unit).
+    pub atol: [f64; N],
+    /// Smallest step before [`SolveError::StepSizeUnderflow`] (s).
+    pub h_min: f64,
+    /// Step attempts (accepted + rejected) before [`SolveError::StepBudget`].
+    pub max_attempts: u64,
+    /// Fixed step size (s) instead of adaptive control: every step is accepted. For
+    /// convergence-order studies; `None` in normal use.
+    pub fixed_step: Option<f64>,
+}
+
+/// The 4th-order continuous extension of one accepted step, valid on `[t0, t_end]`.
+#[derive(Debug, Clone)]
+pub struct Dense<const N: usize> {
+    t0: f64,
+    h: f64,
+    t_end: f64,
+    r: [[f64; N]; 5],
+}
+
+impl<const N: usize> Dense<N> {
+    /// Start of the step (s).
+    pub fn t0(&self) -> f64 {
+        self.t0
+    }
+    /// End of the (possibly event-truncated) step (s).
+    pub fn t1(&self) -> f64 {
+        self.t_end
+    }
+    /// State at `t` (meant for `t` in `[t0, t1]`).
+    #[inline]
+    pub fn eval(&self, t: f64) -> [f64; N] {
+        let th = (t - self.t0) / self.h;
+        let th1 = 1.0 - th;
+        let mut y = [0.0; N];
+        for i in 0..N {
+            y[i] = self.r[0][i]
+                + th * (self.r[1][i]
+                    + th1 * (self.r[2][i] + th * (self.r[3][i] + th1 * self.r[4][i])));
+        }
+        y
+    }
+    /// State at the start of the step.
+    pub fn y0(&self) -> [f64; N] {
+        self.r[0]
+    }
+    /// State at the end of the (possibly truncated) step.
+    pub fn y1(&self) -> [f64; N] {
+        if self.t_end == self.t0 + self.h {
+            let mut y = [0.0; N];
+            for i in 0..N {
+                y[i] = self.r[0][i] + self.r[1][i];
+            }
+            y
+        } else {
+            self.eval(self.t_end)
+        }
+    }
+}
+
+/// The stepper: stage storage, the FSAL derivative, controller memory and work counters.
+#[derive(Debug, Clone)]
+pub struct Dopri5<const N: usize> {
+    ctl: StepControl<N>,
+    /// Work counters, accumulated over every call.
+    pub stats: Stats,
+    h: f64,
+    err_old: f64,
+    k1: [f64; N],
+    dense: Dense<N>,
+    dy_last: [f64; N],
+}
+
+impl<const N: usize> Dopri5<N> {
+    /// A stepper with the given control settings and no step-size history.
+    pub fn new(ctl: StepControl<N>) -> Self {
+        Self {
+            ctl,
+            stats: Stats::default(),
+            h: 0.0,
+            err_old: 1e-4,
+            k1: [0.0; N],
+            dense: Dense {
+                t0: 0.0,
+                h: 1.0,
+                t_end: 0.0,
+                r: [[0.0; N]; 5],
+            },
+            dy_last: [0.0; N],
+        }
+    }
+
+    /// Evaluates the derivative at `(t, y)` (a clean restart after a mode switch) and, on the
+    /// first call, picks an initial step (Hairer's `hinit`).
+    pub fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
+        sys.rhs(t, y, &mut self.k1);
+        self.stats.rhs_evals += 1;
+        if let Some(hf) = self.ctl.fixed_step {
+            self.h = hf;
+            return;
+        }
+        if self.h == 0.0 {
+            let (mut d0, mut d1) = (0.0, 0.0);
+            for i in 0..N {
+                let sc = self.ctl.atol[i] + self.ctl.rtol * y[i].abs();
+                d0 += (y[i] / sc).powi(2);
+                d1 += (self.k1[i] / sc).powi(2);
+            }
+            let (d0, d1) = ((d0 / N as f64).sqrt(), (d1 / N as f64).sqrt());
+            let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+                1e-6
+            } else {
+                0.01 * d0 / d1
+            };
+            self.h = h0.min(sys.max_step()).max(self.ctl.h_min * 10.0);
+        }
+    }
+
+    /// The interpolant of the last accepted step.
+    pub fn last_dense(&self) -> &Dense<N> {
+        &self.dense
+    }
+    /// The derivative at the end of the last accepted step.
+    pub fn last_dy(&self) -> &[f64; N] {
+        &self.dy_last
+    }
+
+    /// The last accepted step cut at `t_cut` (an event time inside it). The following call to
+    /// [`Dopri5::restart`] re-evaluates the derivative there.
+    pub fn truncate<S: OdeSystem<N>>(&mut self, sys: &S, t_cut: f64) -> (Dense<N>, [f64; N]) {
+        let mut d = self.dense.clone();
+        d.t_end = t_cut;
+        let y = d.y1();
+        let mut dy = [0.0; N];
+        sys.rhs(t_cut, &y, &mut dy);
+        self.stats.rhs_evals += 1;
+        (d, dy)
+    }
+
+    /// Takes one accepted step from `(t, y)` of at most `h_cap`, retrying rejected attempts.
+    pub fn step<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64; N],
+        h_cap: f64,
+    ) -> Result<&Dense<N>, SolveError> {
+        const SAFE: f64 = 0.9;
+        const BETA: f64 = 0.04;
+        const EXPO1: f64 = 0.2 - BETA * 0.75;
+        const FAC_MIN: f64 = 0.2; // largest shrink: h / 5
+        const FAC_MAX: f64 = 10.0; // largest growth
+        let mut rejected_last = false;
+        loop {
+            if self.stats.steps + self.stats.rejected >= self.ctl.max_attempts {
+                return Err(SolveError::StepBudget {
+                    t_s: t,
+                    attempts: self.stats.steps + self.stats.rejected,
+                });
+            }
+            let h = self.h.min(h_cap);
+            if h < self.ctl.h_min && h < h_cap {
+                return Err(SolveError::StepSizeUnderflow { t_s: t, h_s: h });
+            }
+            let (y_new, k7, k, err) = self.attempt(sys, t, y, h);
+            let fixed = self.ctl.fixed_step.is_some();
+            if !err.is_finite() && (fixed || h <= self.ctl.h_min) {
+                return Err(SolveError::NonFiniteState { t_s: t });
+            }
+            if fixed || (err.is_finite() && err <= 1.0) {
+                // Accept: build the dense output, keep k7 as the next step's k1 (FSAL).
+                let mut r = [[0.0; N]; 5];
+                for i in 0..N {
+                    let ydiff = y_new[i] - y[i];
+                    let bspl = h * self.k1[i] - ydiff;
+                    r[0][i] = y[i];
+                    r[1][i] = ydiff;
+                    r[2][i] = bspl;
+                    r[3][i] = ydiff - h * k7[i] - bspl;
+                    r[4][i] = h
+                        * (D1 * self.k1[i]
+                            + D3 * k[0][i]
+                            + D4 * k[1][i]
+                            + D5 * k[2][i]
+                            + D6 * k[3][i]
+                            + D7 * k7[i]);
+                }
+                self.dense = Dense {
+                    t0: t,
+                    h,
+                    t_end: t + h,
+                    r,
+                };
+                self.k1 = k7;
+                self.dy_last = k7;
+                self.stats.steps += 1;
+                if !fixed {
+                    let fac11 = err.max(1e-10).powf(EXPO1);
+                    let fac = (fac11 / self.err_old.powf(BETA) / SAFE)
+                        .clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+                    let mut h_new = h / fac;
+                    if rejected_last {
+                        h_new = h_new.min(h);
+                    }
+                    self.err_old = err.max(1e-4);
+                    // Keep a capped step's growth honest: grow from the step actually taken.
+                    self.h = h_new;
+                }
+                return Ok(&self.dense);
+            }
+            self.stats.rejected += 1;
+            rejected_last = true;
+            self.h = if err.is_finite() {
+                h / (err.powf(EXPO1) / SAFE).min(1.0 / FAC_MIN)
+            } else {
+                h * FAC_MIN
+            };
+        }
+    }
+
+    /// One trial step: the 5th-order solution, the end derivative, stages 3-6, and the error
+    /// norm (RMS of the embedded error over `atol + rtol * max(|y0|, |y1|)`).
+    #[allow(clippy::type_complexity)]
+    fn attempt<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64; N],
+        h: f64,
+    ) -> ([f64; N], [f64; N], [[f64; N]; 4], f64) {
+        let k1 = &self.k1;
+        let mut yt = [0.0; N];
+        let (mut k2, mut k3, mut k4, mut k5, mut k6, mut k7) =
+            ([0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+        for i in 0..N {
+            yt[i] = y[i] + h * A21 * k1[i];
+        }
+        sys.rhs(t + C2 * h, &yt, &mut k2);
+        for i in 0..N {
+            yt[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i]);
+        }
+        sys.rhs(t + C3 * h, &yt, &mut k3);
+        for i in 0..N {
+            yt[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
+        }
+        sys.rhs(t + C4 * h, &yt, &mut k4);
+        for i in 0..N {
+            yt[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
+        }
+        sys.rhs(t + C5 * h, &yt, &mut k5);
+        for i in 0..N {
+            yt[i] =
+                y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
+        }
+        sys.rhs(t + h, &yt, &mut k6);
+        let mut y_new = [0.0; N];
+        for i in 0..N {
+            y_new[i] =
+                y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
+        }
+        sys.rhs(t + h, &y_new, &mut k7);
+        self.stats.rhs_evals += 6;
+        let mut acc = 0.0;
+        for i in 0..N {
+            let e =
+                h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
+            let sc = self.ctl.atol[i] + self.ctl.rtol * y[i].abs().max(y_new[i].abs());
+            acc += (e / sc) * (e / sc);
+        }
+        let err = (acc / N as f64).sqrt();
+        (y_new, k7, [k3, k4, k5, k6], err)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ode::{integrate, NoObserver, Stop};
+
+    /// x'' = -x as a first-order system; exact solution cos t.
+    struct Harmonic;
+    impl OdeSystem<2> for Harmonic {
+        fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+            dy[0] = y[1];
+            dy[1] = -y[0];
+        }
+    }
+
+    /// y' = -2 y; exact solution exp(-2 t).
+    struct Decay;
+    impl OdeSystem<1> for Decay {
+        fn rhs(&self, _t: f64, y: &[f64; 1], dy: &mut [f64; 1]) {
+            dy[0] = -2.0 * y[0];
+        }
+    }
+
+    fn fixed(h: f64) -> StepControl<2> {
+        StepControl {
+            rtol: 1.0,
+            atol: [1.0; 2],
+            h_min: 0.0,
+            max_attempts: u64::MAX,
+            fixed_step: Some(h),
+        }
+    }
+
+    #[test]
+    fn fixed_step_error_falls_at_fifth_order() {
+        let err_at = |n: usize| {
+            let mut st = Dopri5::new(fixed(2.0 / n as f64));
+            let (mut t, mut y) = (0.0, [1.0, 0.0]);
+            integrate(&Harmonic, &mut st, &mut t, &mut y, 2.0, &mut NoObserver).unwrap();
+            // Error norm of the whole state, so a zero of one component cannot fake an order.
+            ((y[0] - 2.0f64.cos()).powi(2) + (y[1] + 2.0f64.sin()).powi(2)).sqrt()
+        };
+        let (e1, e2) = (err_at(40), err_at(80));
+        let order = (e1 / e2).log2();
+        assert!(
+            (order - 5.0).abs() < 0.3,
+            "observed order {order} ({e1:e} -> {e2:e})"
+        );
+    }
+
+    #[test]
+    fn dense_output_is_fourth_order_inside_a_step() {
+        let err_at = |h: f64| {
+            let mut st = Dopri5::new(fixed(h));
+            st.restart(&Harmonic, 0.0, &[1.0, 0.0]);
+            let d = st.step(&Harmonic, 0.0, &[1.0, 0.0], h).unwrap().clone();
+            (d.eval(0.37 * h)[0] - (0.37 * h).cos()).abs()
+        };
+        let order = (err_at(0.2) / err_at(0.1)).log2();
+        // Local error of an order-4 interpolant scales like h^5.
+        assert!(order > 4.6, "interpolant local order {order}");
+    }
+
+    #[test]
+    fn adaptive_error_tracks_tolerance_on_exponential_decay() {
+        for rtol in [1e-4, 1e-7, 1e-10] {
+            let ctl = StepControl {
+                rtol,
+                atol: [rtol * 1e-3],
+                h_min: 1e-14,
+                max_attempts: 100_000,
+                fixed_step: None,
+            };
+            let mut st = Dopri5::new(ctl);
+            let (mut t, mut y) = (0.0, [1.0]);
+            let stop = integrate(&Decay, &mut st, &mut t, &mut y, 3.0, &mut NoObserver).unwrap();
+            assert_eq!(stop, Stop::EndTime);
+            assert_eq!(t, 3.0);
+            let rel = (y[0] - (-6.0f64).exp()).abs() / (-6.0f64).exp();
+            assert!(rel < 50.0 * rtol, "rtol {rtol}: relative error {rel:e}");
+        }
+    }
+
+    #[test]
+    fn non_finite_rhs_is_a_typed_error_with_time() {
+        struct Blow;
+        impl OdeSystem<1> for Blow {
+            fn rhs(&self, t: f64, _y: &[f64; 1], dy: &mut [f64; 1]) {
+                dy[0] = if t > 0.5 { f64::NAN } else { 1.0 };
+            }
+        }
+        let ctl = StepControl {
+            rtol: 1e-8,
+            atol: [1e-8],
+            h_min: 1e-12,
+            max_attempts: 10_000,
+            fixed_step: None,
+        };
+        let mut st = Dopri5::new(ctl);
+        let (mut t, mut y) = (0.0, [0.0]);
+        match integrate(&Blow, &mut st, &mut t, &mut y, 1.0, &mut NoObserver) {
+            Err(SolveError::NonFiniteState { t_s })
+            | Err(SolveError::StepSizeUnderflow { t_s, .. }) => {
+                assert!((0.4..=0.5).contains(&t_s), "{t_s}")
+            }
+            other => panic!("expected a typed failure, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn event_on_a_falling_ball_is_located_at_the_closed_form_time() {
+        // y'' = -g from height 1 m: the guard y crosses zero at sqrt(2/g).
+        struct Ball;
+        impl OdeSystem<2> for Ball {
+            fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+                dy[0] = y[1];
+                dy[1] = -9.81;
+            }
+            fn guards(
+                &self,
+                _t: f64,
+                y: &[f64; 2],
+                g: &mut [f64; crate::ode::MAX_GUARDS],
+            ) -> usize {
+                g[0] = y[0];
+                1
+            }
+            fn max_step(&self) -> f64 {
+                0.1
+            }
+        }
+        let ctl = StepControl {
+            rtol: 1e-6,
+            atol: [1e-9; 2],
+            h_min: 1e-14,
+            max_attempts: 10_000,
+            fixed_step: None,
+        };
+        let mut st = Dopri5::new(ctl);
+        let (mut t, mut y) = (0.0, [1.0, 0.0]);
+        let stop = integrate(&Ball, &mut st, &mut t, &mut y, 10.0, &mut NoObserver).unwrap();
+        assert_eq!(stop, Stop::Event { index: 0 });
+        let exact = (2.0 / 9.81f64).sqrt();
+        assert!((t - exact).abs() < 1e-12, "event at {t}, exact {exact}");
+        assert!(y[0] <= 0.0 && y[0] > -1e-12);
+    }
+}
