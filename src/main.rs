@@ -1,1 +1,220 @@
-fn main(){}
+//! `whirlmap`: simulate rotor drops onto touchdown bearings.
+//!
+//! Exit codes: 0 success; 2 bad input (usage, invalid parameter, unreadable scene file,
+//! unsupported chart extension); 3 the simulation failed (a typed solver error); 4 an output
+//! could not be written.
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+use whirlmap_core::{simulate, DropOptions, DropReport, Scene};
+use whirlmap_sweep::classify::ClassifyParams;
+use whirlmap_sweep::overrides::apply_assignment;
+use whirlmap_sweep::record::DropRecord;
+use whirlmap_sweep::render::{draw_orbit, ImageFormat};
+
+mod bench;
+
+#[derive(Parser)]
+#[command(
+    name = "whirlmap",
+    version,
+    about = "Rotor drops onto AMB touchdown bearings: orbits, whirl, design charts"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate one drop and print its outputs.
+    Drop(DropArgs),
+    /// Print the default scene (the paper's) as JSON: a starting file for --scene.
+    Scene,
+    /// Time a pendulum drop, a whirl drop and one right-hand-side evaluation.
+    Bench(bench::BenchArgs),
+}
+
+#[derive(clap::Args)]
+struct DropArgs {
+    /// Rotor speed at release (r/min); default: the scene's (8000).
+    #[arg(long, allow_negative_numbers = true)]
+    speed_rpm: Option<f64>,
+    /// Dynamic friction coefficient rotor-race, [0, 2]; default: the scene's (0.1).
+    #[arg(long, allow_negative_numbers = true)]
+    mu: Option<f64>,
+    /// Scene file (JSON); any subset of the fields printed by `whirlmap scene`.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Override one scene parameter, e.g. `--set clearance_m=2e-4 --set solver.rtol=1e-7`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Simulated time after release (s).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    duration_s: f64,
+    /// Print the JSON record instead of a summary.
+    #[arg(long)]
+    json: bool,
+    /// Draw the orbit (Fig. 3 view) to this .png or .svg file.
+    #[arg(long)]
+    orbit: Option<PathBuf>,
+}
+
+/// A failure with its exit code.
+enum Failure {
+    Input(anyhow::Error),
+    Solve(anyhow::Error),
+    Output(anyhow::Error),
+}
+
+impl Failure {
+    fn code(&self) -> u8 {
+        match self {
+            Failure::Input(_) => 2,
+            Failure::Solve(_) => 3,
+            Failure::Output(_) => 4,
+        }
+    }
+    fn error(&self) -> &anyhow::Error {
+        match self {
+            Failure::Input(e) | Failure::Solve(e) | Failure::Output(e) => e,
+        }
+    }
+}
+
+/// Default scene, then the scene file, then `--set`, then the explicit flags; validated.
+fn build_scene(
+    file: Option<&Path>,
+    sets: &[String],
+    speed_rpm: Option<f64>,
+    mu: Option<f64>,
+) -> anyhow::Result<Scene> {
+    let mut scene = match file {
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("cannot read scene file {}", p.display()))?;
+            serde_json::from_str::<Scene>(&text)
+                .with_context(|| format!("scene file {}", p.display()))?
+        }
+        None => Scene::paper(),
+    };
+    for s in sets {
+        apply_assignment(&mut scene, s).with_context(|| format!("--set {s}"))?;
+    }
+    if let Some(v) = speed_rpm {
+        scene.speed_rpm = v;
+    }
+    if let Some(v) = mu {
+        scene.mu_dynamic = v;
+    }
+    scene.validate()?;
+    Ok(scene)
+}
+
+fn run_drop(a: &DropArgs) -> Result<(), Failure> {
+    let scene =
+        build_scene(a.scene.as_deref(), &a.set, a.speed_rpm, a.mu).map_err(Failure::Input)?;
+    if let Some(p) = &a.orbit {
+        ImageFormat::from_path(p).map_err(|e| Failure::Input(e.into()))?;
+    }
+    let opts = DropOptions {
+        duration_s: a.duration_s,
+        orbit_points: a.orbit.as_ref().map(|_| 20_000),
+        ..Default::default()
+    };
+    opts.validate().map_err(|e| Failure::Input(e.into()))?;
+    let start = Instant::now();
+    let report = simulate(&scene, &opts)
+        .map_err(|e| Failure::Solve(anyhow::anyhow!("simulation failed ({}): {e}", e.kind())))?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let record = DropRecord::from_report(&report, &ClassifyParams::default());
+    if let (Some(path), Some(orbit)) = (&a.orbit, &report.orbit) {
+        let title = format!(
+            "{:.0} r/min, mu = {:.2}: {}",
+            scene.speed_rpm,
+            scene.mu_dynamic,
+            record.class.label()
+        );
+        draw_orbit(path, &title, orbit).map_err(|e| Failure::Output(e.into()))?;
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&record).expect("records serialise")
+        );
+    } else {
+        print_summary(&scene, &report, &record, wall_s);
+        if let Some(p) = &a.orbit {
+            println!("  orbit chart           {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
+    let f = &r.features;
+    let e = &r.energy;
+    let why = match r.stop_reason {
+        whirlmap_core::StopReason::DurationReached => "duration reached",
+        whirlmap_core::StopReason::WhirlTurnsReached => "stopped: whirl decided",
+    };
+    println!(
+        "whirlmap drop: {:.0} r/min, mu_d {:.3}, {:.4} s simulated ({why})",
+        scene.speed_rpm, scene.mu_dynamic, r.end_time_s
+    );
+    println!("  class                 {}", rec.class.label());
+    println!("  first contact force   {:.1} N", f.first_contact_force_n);
+    println!(
+        "  max contact force     {:.1} N (at {:.2} ms)",
+        f.max_contact_force_n,
+        f.max_contact_force_time_s * 1e3
+    );
+    println!("  peak friction power   {:.1} W", f.peak_friction_power_w);
+    println!("  peak heat power       {:.1} W", f.peak_heat_power_w);
+    println!(
+        "  whirl frequency       {:+.2} Hz (net turns {:+.2}; negative = against the spin)",
+        f.whirl_frequency_hz, f.net_whirl_turns
+    );
+    println!(
+        "  contact duty          {:.3} (window {:.3}-{:.3} s), {} impacts",
+        f.window.contact_duty, f.window.start_s, f.window.end_s, f.impacts
+    );
+    println!(
+        "  final speeds          rotor {:.0} r/min, race {:.0} r/min",
+        f.final_rotor_speed_rpm, f.final_race_speed_rpm
+    );
+    println!(
+        "  energy (J)            initial {:.4} = final {:.4} + friction {:.4} + damping {:.6} + drag {:.4}  (residual {:.1e})",
+        e.initial_j, e.final_j, e.friction_heat_j, e.damping_loss_j, e.drag_work_j, e.residual_rel
+    );
+    println!(
+        "  work                  {} RHS evaluations, {} steps ({} rejected), {} events, {:.3} s wall",
+        r.stats.rhs_evals, r.stats.steps, r.stats.rejected, r.stats.events, wall_s
+    );
+    println!("  scene hash            {}", r.scene_hash);
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Drop(a) => run_drop(a),
+        Command::Scene => {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&Scene::paper()).expect("scene serialises")
+            );
+            Ok(())
+        }
+        Command::Bench(a) => bench::run(a).map_err(Failure::Solve),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("error: {:#}", f.error());
+            ExitCode::from(f.code())
+        }
+    }
+}

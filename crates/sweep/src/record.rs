@@ -1,0 +1,66 @@
+//! The JSON record of one drop. Field names are a contract that later work and users rely on
+//! (see the README's "JSON contract").
+
+use crate::classify::{classify, ClassifyParams, OrbitClass};
+use serde::{Deserialize, Serialize};
+use whirlmap_core::ode::Stats;
+use whirlmap_core::{DropReport, EnergyAudit, Features, StopReason, MODEL_VERSION};
+
+/// One drop's outputs, as written by `whirlmap drop --json` and, per point, by sweeps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DropRecord {
+    /// Orbit class.
+    pub class: OrbitClass,
+    /// Peak force of the first impact after free fall (N).
+    pub first_contact_force_n: f64,
+    /// Maximum rotor-race contact force over the run (N).
+    pub max_contact_force_n: f64,
+    /// Peak friction power H_s (W), eq. 17.
+    pub peak_friction_power_w: f64,
+    /// Peak heat power H = H_s + bearing drag power (W).
+    pub peak_heat_power_w: f64,
+    /// Whirl frequency (Hz), signed: negative is opposite to the spin.
+    pub whirl_frequency_hz: f64,
+    /// Fraction of the classification window with the contact active.
+    pub contact_duty: f64,
+    /// Impacts (contact episodes, merged within 0.5 ms).
+    pub impacts: u64,
+    /// Simulated time reached (s).
+    pub end_time_s: f64,
+    /// Why the run ended.
+    pub stop_reason: StopReason,
+    /// The energy audit.
+    pub energy: EnergyAudit,
+    /// Integrator work counters.
+    pub stats: Stats,
+    /// Stable hash of the scene.
+    pub scene_hash: String,
+    /// Model version the record was made with.
+    pub model_version: u32,
+    /// Every streamed feature (for diagnostics and re-classification).
+    pub features: Features,
+}
+
+impl DropRecord {
+    /// Builds the record of a finished drop, classifying it with `params`.
+    pub fn from_report(r: &DropReport, params: &ClassifyParams) -> Self {
+        let f = &r.features;
+        Self {
+            class: classify(f, r.stop_reason, params),
+            first_contact_force_n: f.first_contact_force_n,
+            max_contact_force_n: f.max_contact_force_n,
+            peak_friction_power_w: f.peak_friction_power_w,
+            peak_heat_power_w: f.peak_heat_power_w,
+            whirl_frequency_hz: f.whirl_frequency_hz,
+            contact_duty: f.window.contact_duty,
+            impacts: f.impacts,
+            end_time_s: r.end_time_s,
+            stop_reason: r.stop_reason,
+            energy: r.energy,
+            stats: r.stats,
+            scene_hash: r.scene_hash.clone(),
+            model_version: MODEL_VERSION,
+            features: r.features,
+        }
+    }
+}

@@ -1,0 +1,621 @@
+//! Chart drawing: PNG or SVG, chosen by the output file's extension.
+//!
+//! Every chart is a [`Figure`]: one drawing routine generic over the plotters backend, which
+//! [`render`] runs on a bitmap (PNG) or SVG backend. Text uses only the embedded font
+//! registered by [`crate::fonts`], so charts render on machines without system fonts.
+//!
+//! Bad data never panics: non-finite points are skipped, and empty data still yields a figure
+//! with its axes (and, for orbits, the clearance circle).
+
+use std::fmt::Display;
+use std::path::{Path, PathBuf};
+
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use whirlmap_core::orbit::{Orbit, OrbitSample};
+
+use crate::fonts::{self, FontError, FONT_FAMILY};
+
+/// Size (width, height) in pixels of the orbit figure drawn by [`draw_orbit`].
+pub const ORBIT_FIGURE_SIZE: (u32, u32) = (900, 1100);
+
+/// Most samples [`draw_orbit`] draws; longer orbits are thinned by [`decimate_samples`].
+pub const MAX_DRAWN_SAMPLES: usize = 20_000;
+
+/// Image file format, chosen from the output path's extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// Raster image (`.png`).
+    Png,
+    /// Vector image (`.svg`).
+    Svg,
+}
+
+impl ImageFormat {
+    /// The format for `path`'s extension (`.png` or `.svg`, any letter case).
+    pub fn from_path(path: &Path) -> Result<Self, RenderError> {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if ext.eq_ignore_ascii_case("png") {
+            Ok(Self::Png)
+        } else if ext.eq_ignore_ascii_case("svg") {
+            Ok(Self::Svg)
+        } else {
+            Err(RenderError::UnsupportedExtension {
+                path: path.to_path_buf(),
+            })
+        }
+    }
+}
+
+/// Why a chart could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// The output path's extension is neither `.png` nor `.svg`.
+    #[error("cannot write chart {}: unsupported file extension, expected .png or .svg", path.display())]
+    UnsupportedExtension {
+        /// The requested output path.
+        path: PathBuf,
+    },
+    /// The embedded font could not be registered.
+    #[error("cannot write chart {}: {cause}", path.display())]
+    Font {
+        /// The requested output path.
+        path: PathBuf,
+        /// What went wrong with the font.
+        cause: FontError,
+    },
+    /// Drawing or saving failed (e.g. the directory does not exist), or the size was zero.
+    #[error("cannot write chart {}: {cause}", path.display())]
+    Draw {
+        /// The requested output path.
+        path: PathBuf,
+        /// The backend's description of the failure.
+        cause: String,
+    },
+}
+
+/// Result of drawing on a backend `DB`: plotters' own error type, so `?` works in figures.
+pub type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+/// A chart that can draw itself on any plotters backend, so the same code yields PNG and SVG.
+pub trait Figure {
+    /// Draws the figure on `root`, which covers the whole image and is already filled white.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB>;
+}
+
+/// Writes `figure` to `path` as a `size` (width, height) pixel PNG or SVG, by extension.
+///
+/// Registers the embedded font first. On a drawing error, any partly written file is removed.
+pub fn render<F: Figure>(path: &Path, size: (u32, u32), figure: &F) -> Result<(), RenderError> {
+    let format = ImageFormat::from_path(path)?;
+    fonts::register_embedded_fonts().map_err(|cause| RenderError::Font {
+        path: path.to_path_buf(),
+        cause,
+    })?;
+    let fail = |cause: &dyn Display| RenderError::Draw {
+        path: path.to_path_buf(),
+        cause: cause.to_string(),
+    };
+    if size.0 == 0 || size.1 == 0 {
+        return Err(fail(&format_args!(
+            "image size {}x{} is empty",
+            size.0, size.1
+        )));
+    }
+    let result = match format {
+        ImageFormat::Png => {
+            let root = BitMapBackend::new(path, size).into_drawing_area();
+            let r = draw_and_present(&root, figure).map_err(|e| fail(&e));
+            drop(root); // a failed present is retried (and ignored) on drop
+            r
+        }
+        ImageFormat::Svg => {
+            let root = SVGBackend::new(path, size).into_drawing_area();
+            let r = draw_and_present(&root, figure).map_err(|e| fail(&e));
+            drop(root);
+            r
+        }
+    };
+    if result.is_err() {
+        let _ = std::fs::remove_file(path);
+    }
+    result
+}
+
+fn draw_and_present<DB: DrawingBackend, F: Figure>(
+    root: &DrawingArea<DB, Shift>,
+    figure: &F,
+) -> DrawResult<DB> {
+    root.fill(&WHITE)?;
+    figure.draw(root)?;
+    root.present()
+}
+
+/// Draws a recorded orbit, the paper's Fig. 3 view, to `path` (`.png` or `.svg`).
+///
+/// Top: the rotor centre's path relative to the race in µm, equal aspect, inside the dashed
+/// clearance circle, with the release and final positions marked. Bottom: the contact force
+/// against time. Orbits longer than [`MAX_DRAWN_SAMPLES`] are thinned for drawing by
+/// [`decimate_samples`], which keeps every bucket's force peak.
+pub fn draw_orbit(path: &Path, title: &str, orbit: &Orbit) -> Result<(), RenderError> {
+    let figure = OrbitFigure {
+        title,
+        clearance_m: orbit.clearance_m,
+        samples: decimate_samples(&orbit.samples, MAX_DRAWN_SAMPLES),
+    };
+    render(path, ORBIT_FIGURE_SIZE, &figure)
+}
+
+/// Thins `samples` to at most `max_points` (at least 4) for drawing.
+///
+/// Keeps the first and last samples; splits the rest into equal buckets and keeps, from each,
+/// its first sample (for the path's shape) and its largest finite contact force (so no force
+/// peak is lost), in time order. Returns the samples unchanged if they already fit.
+pub fn decimate_samples(samples: &[OrbitSample], max_points: usize) -> Vec<OrbitSample> {
+    let max_points = max_points.max(4);
+    let n = samples.len();
+    if n <= max_points {
+        return samples.to_vec();
+    }
+    let interior = n - 2;
+    let buckets = (max_points - 2) / 2;
+    let mut out = Vec::with_capacity(max_points);
+    out.push(samples[0]);
+    for b in 0..buckets {
+        let start = 1 + b * interior / buckets;
+        let end = 1 + (b + 1) * interior / buckets;
+        if start >= end {
+            continue;
+        }
+        out.push(samples[start]);
+        let peak = (start..end)
+            .filter(|&i| samples[i].contact_force_n.is_finite())
+            .max_by(|&i, &j| {
+                samples[i]
+                    .contact_force_n
+                    .total_cmp(&samples[j].contact_force_n)
+            });
+        if let Some(i) = peak.filter(|&i| i != start) {
+            out.push(samples[i]);
+        }
+    }
+    out.push(samples[n - 1]);
+    out
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shared styling and layout helpers for all charts.
+
+/// Figure title font size (px).
+const TITLE_FONT: f64 = 26.0;
+/// Panel caption font size (px).
+const CAPTION_FONT: f64 = 19.0;
+/// Axis description font size (px).
+const AXIS_DESC_FONT: f64 = 17.0;
+/// Tick label and legend font size (px).
+const TICK_FONT: f64 = 15.0;
+/// Height of the band holding the figure title (px).
+const TITLE_BAND: u32 = 50;
+/// Space for the x tick labels and axis description below a plot (px).
+const X_LABEL_AREA: u32 = 58;
+/// Space for the y tick labels and axis description left of a plot (px).
+const Y_LABEL_AREA: u32 = 82;
+
+const TEXT_COLOUR: RGBColor = RGBColor(30, 30, 30);
+const AXIS_COLOUR: RGBColor = RGBColor(90, 90, 90);
+const GRID_BOLD: RGBColor = RGBColor(212, 212, 212);
+const GRID_LIGHT: RGBColor = RGBColor(236, 236, 236);
+const PATH_COLOUR: RGBColor = RGBColor(31, 119, 180);
+const FORCE_COLOUR: RGBColor = RGBColor(190, 50, 40);
+const CLEARANCE_COLOUR: RGBColor = RGBColor(120, 120, 120);
+const START_COLOUR: RGBColor = RGBColor(44, 160, 44);
+const END_COLOUR: RGBColor = RGBColor(214, 39, 40);
+
+fn text_style(size: f64) -> TextStyle<'static> {
+    TextStyle::from((FONT_FAMILY, size).into_font()).color(&TEXT_COLOUR)
+}
+
+/// Draws `text` centred in `area`, shrinking the font (down to 12 px) so it fits the width.
+fn draw_centered_text<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    size: f64,
+) -> DrawResult<DB> {
+    let (w, h) = area.dim_in_pixel();
+    let mut size = size;
+    while size > 12.0
+        && area.estimate_text_size(text, &text_style(size))?.0 as f64 > w as f64 * 0.96
+    {
+        size -= 1.0;
+    }
+    let style = text_style(size).pos(Pos::new(HPos::Center, VPos::Center));
+    area.draw_text(text, &style, (w as i32 / 2, h as i32 / 2))
+}
+
+/// Splits off a band of `height` px at the top of `area` with `text` centred in it; returns
+/// the rest.
+fn with_header<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    height: u32,
+    text: &str,
+    size: f64,
+) -> Result<DrawingArea<DB, Shift>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let (band, rest) = area.split_vertically(height);
+    draw_centered_text(&band, text, size)?;
+    Ok(rest)
+}
+
+/// How a legend entry is marked.
+#[derive(Clone, Copy)]
+enum LegendMark {
+    Line(RGBColor),
+    Dashed(RGBColor),
+    Dot(RGBColor),
+}
+
+/// Draws a one-row legend centred in `area` (outside the plot, so it never hides data).
+fn draw_legend_row<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(LegendMark, &str)],
+) -> DrawResult<DB> {
+    const MARK_W: i32 = 26;
+    const MARK_GAP: i32 = 7;
+    const ENTRY_GAP: i32 = 30;
+    let style = text_style(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center));
+    let mut widths = Vec::with_capacity(entries.len());
+    for (_, label) in entries {
+        widths.push(area.estimate_text_size(label, &style)?.0 as i32);
+    }
+    let total: i32 = widths.iter().map(|w| MARK_W + MARK_GAP + w).sum::<i32>()
+        + ENTRY_GAP * (entries.len() as i32 - 1).max(0);
+    let (w, h) = area.dim_in_pixel();
+    let y = h as i32 / 2;
+    let mut x = (w as i32 - total).max(0) / 2;
+    for ((mark, label), text_w) in entries.iter().zip(widths) {
+        match *mark {
+            LegendMark::Line(c) => area.draw(&PathElement::new(
+                vec![(x, y), (x + MARK_W, y)],
+                c.stroke_width(2),
+            ))?,
+            LegendMark::Dashed(c) => area.draw(&DashedPathElement::new(
+                vec![(x, y), (x + MARK_W, y)],
+                7,
+                4,
+                c.stroke_width(2),
+            ))?,
+            LegendMark::Dot(c) => area.draw(&Circle::new((x + MARK_W / 2, y), 5, c.filled()))?,
+        }
+        area.draw_text(label, &style, (x + MARK_W + MARK_GAP, y))?;
+        x += MARK_W + MARK_GAP + text_w + ENTRY_GAP;
+    }
+    Ok(())
+}
+
+/// A tick-label formatter for an axis spanning `span`: enough decimals for the tick step,
+/// trailing zeros trimmed, scientific notation for very large or small values.
+fn tick_formatter(span: f64) -> impl Fn(&f64) -> String {
+    let span = if span.is_finite() && span > 0.0 {
+        span
+    } else {
+        1.0
+    };
+    let decimals = (2.0 - span.log10().floor()).clamp(0.0, 8.0) as usize;
+    move |&v: &f64| {
+        if v.abs() < span * 1e-9 {
+            return "0".to_string();
+        }
+        if v.abs() >= 1e6 || span < 1e-4 {
+            return format!("{v:.2e}");
+        }
+        let s = format!("{v:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    }
+}
+
+/// `value` with about three significant digits, for captions.
+fn format_quantity(value: f64) -> String {
+    let a = value.abs();
+    if !value.is_finite() {
+        "n/a".to_string()
+    } else if a >= 1e6 || (a < 1e-2 && a > 0.0) {
+        format!("{value:.2e}")
+    } else if a >= 100.0 {
+        format!("{value:.0}")
+    } else if a >= 10.0 {
+        format!("{value:.1}")
+    } else {
+        format!("{value:.2}")
+    }
+}
+
+/// (min, max) of the finite values, or `None` if there are none.
+fn finite_bounds(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
+    values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold(None, |acc, v| match acc {
+            None => Some((v, v)),
+            Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+        })
+}
+
+/// A non-degenerate axis range from optional data bounds, widened by `pad` of its span.
+fn padded_range(bounds: Option<(f64, f64)>, pad: f64) -> (f64, f64) {
+    match bounds {
+        None => (0.0, 1.0),
+        Some((lo, hi)) if hi - lo > 0.0 && (hi - lo).is_finite() => {
+            let p = (hi - lo) * pad;
+            (lo - p, hi + p)
+        }
+        Some((lo, _)) => {
+            let half = if lo == 0.0 { 0.5 } else { lo.abs() * 0.05 };
+            (lo - half, lo + half)
+        }
+    }
+}
+
+/// Applies the common axis styling (fonts, grid, units, tick formats) to `chart`'s mesh.
+fn draw_mesh<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    x_desc: &str,
+    y_desc: &str,
+    x_ticks: usize,
+    y_ticks: usize,
+) -> DrawResult<DB> {
+    let x_range = chart.x_range();
+    let y_range = chart.y_range();
+    let x_fmt = tick_formatter(x_range.end - x_range.start);
+    let y_fmt = tick_formatter(y_range.end - y_range.start);
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_labels(x_ticks)
+        .y_labels(y_ticks)
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .label_style(text_style(TICK_FONT))
+        .axis_desc_style(text_style(AXIS_DESC_FONT))
+        .axis_style(AXIS_COLOUR.stroke_width(1))
+        .bold_line_style(GRID_BOLD.stroke_width(1))
+        .light_line_style(GRID_LIGHT.stroke_width(1))
+        .max_light_lines(4)
+        .draw()
+}
+
+// ---------------------------------------------------------------------------------------------
+// The orbit figure.
+
+struct OrbitFigure<'a> {
+    title: &'a str,
+    clearance_m: f64,
+    samples: Vec<OrbitSample>,
+}
+
+/// Fraction of the area below the title given to the orbit (top) panel.
+const ORBIT_PANEL_SHARE: f64 = 0.655;
+
+impl Figure for OrbitFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let body = with_header(root, TITLE_BAND, self.title, TITLE_FONT)?;
+        let top_h = (body.dim_in_pixel().1 as f64 * ORBIT_PANEL_SHARE).round() as u32;
+        let (top, bottom) = body.split_vertically(top_h);
+        self.draw_path_panel(&top)?;
+        self.draw_force_panel(&bottom)
+    }
+}
+
+impl OrbitFigure<'_> {
+    fn clearance_um(&self) -> Option<f64> {
+        let c = self.clearance_m * 1e6;
+        (c.is_finite() && c > 0.0).then_some(c)
+    }
+
+    /// Top panel: rotor-centre path relative to the race, equal aspect, clearance circle.
+    fn draw_path_panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let path: Vec<(f64, f64)> = self
+            .samples
+            .iter()
+            .map(|s| (s.x_rel_m * 1e6, s.y_rel_m * 1e6))
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .collect();
+        let clearance = self.clearance_um();
+
+        let caption = "Rotor-centre path relative to the race";
+        let rest = with_header(area, 34, caption, CAPTION_FONT)?;
+        let (legend_band, plot_area) = rest.split_vertically(26);
+        let mut legend = vec![(LegendMark::Line(PATH_COLOUR), "path".to_string())];
+        if !path.is_empty() {
+            legend.push((LegendMark::Dot(START_COLOUR), "release".to_string()));
+            legend.push((LegendMark::Dot(END_COLOUR), "end".to_string()));
+        }
+        if let Some(c) = clearance {
+            let text = format!("clearance circle, r = {} µm", format_quantity(c));
+            legend.push((LegendMark::Dashed(CLEARANCE_COLOUR), text));
+        }
+        let legend: Vec<(LegendMark, &str)> =
+            legend.iter().map(|(m, t)| (*m, t.as_str())).collect();
+        draw_legend_row(&legend_band, &legend)?;
+
+        // Symmetric range about the race centre covering the circle and every point.
+        let extent = path
+            .iter()
+            .map(|(x, y)| x.abs().max(y.abs()))
+            .chain(clearance)
+            .fold(0.0_f64, f64::max);
+        let extent = if extent > 0.0 && extent.is_finite() {
+            extent
+        } else {
+            1.0
+        };
+        let half = extent * 1.08;
+
+        // Square plotting area, centred horizontally, so the symmetric range is equal-aspect.
+        let (w, h) = plot_area.dim_in_pixel();
+        let (margin_top, margin_bottom) = (8_u32, 6_u32);
+        let side = h
+            .saturating_sub(margin_top + margin_bottom + X_LABEL_AREA)
+            .min(w.saturating_sub(Y_LABEL_AREA + 20))
+            .max(1);
+        let spare = w.saturating_sub(side + Y_LABEL_AREA);
+        let margin_right = (w.saturating_sub(side) / 2).min(spare);
+        let margin_left = spare - margin_right;
+        let mut chart = ChartBuilder::on(&plot_area)
+            .margin_top(margin_top)
+            .margin_bottom(h.saturating_sub(margin_top + side + X_LABEL_AREA))
+            .margin_left(margin_left)
+            .margin_right(margin_right)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
+            .build_cartesian_2d(-half..half, -half..half)?;
+        draw_mesh(&mut chart, "x (µm)", "y (µm)", 9, 9)?;
+
+        if let Some(c) = clearance {
+            let circle = (0..=360).map(|k| {
+                let a = (k as f64).to_radians();
+                (c * a.cos(), c * a.sin())
+            });
+            chart.draw_series(DashedLineSeries::new(
+                circle,
+                8,
+                5,
+                CLEARANCE_COLOUR.stroke_width(2),
+            ))?;
+        }
+        chart.draw_series(LineSeries::new(
+            path.iter().copied(),
+            PATH_COLOUR.stroke_width(1),
+        ))?;
+        if let (Some(&first), Some(&last)) = (path.first(), path.last()) {
+            chart.draw_series([
+                Circle::new(first, 5, START_COLOUR.filled()),
+                Circle::new(last, 5, END_COLOUR.filled()),
+            ])?;
+        }
+        Ok(())
+    }
+
+    /// Bottom panel: contact force against time.
+    fn draw_force_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+    ) -> DrawResult<DB> {
+        let points: Vec<(f64, f64)> = self
+            .samples
+            .iter()
+            .map(|s| (s.t_s * 1e3, s.contact_force_n))
+            .filter(|(t, f)| t.is_finite() && f.is_finite())
+            .collect();
+        let peak = points
+            .iter()
+            .copied()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .filter(|p| p.1 > 0.0);
+        let caption = match peak {
+            Some((t, f)) => format!(
+                "Rotor-race contact force (peak {} N at {} ms)",
+                format_quantity(f),
+                format_quantity(t)
+            ),
+            None => "Rotor-race contact force".to_string(),
+        };
+        let plot_area = with_header(area, 34, &caption, CAPTION_FONT)?;
+
+        let t_range = padded_range(finite_bounds(points.iter().map(|p| p.0)), 0.0);
+        let f_bounds = finite_bounds(points.iter().map(|p| p.1));
+        let f_range = match f_bounds {
+            Some((lo, hi)) if hi > 0.0 => (lo.min(0.0), hi + (hi - lo.min(0.0)) * 0.06),
+            other => padded_range(other.map(|(lo, hi)| (lo.min(0.0), hi.max(0.0))), 0.06),
+        };
+        let mut chart = ChartBuilder::on(&plot_area)
+            .margin_top(8)
+            .margin_bottom(6)
+            .margin_left(20)
+            .margin_right(34)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
+            .build_cartesian_2d(t_range.0..t_range.1, f_range.0..f_range.1)?;
+        draw_mesh(&mut chart, "time (ms)", "contact force (N)", 10, 6)?;
+        if points.is_empty() {
+            let style = text_style(CAPTION_FONT).pos(Pos::new(HPos::Center, VPos::Center));
+            let (w, h) = chart.plotting_area().dim_in_pixel();
+            chart.plotting_area().strip_coord_spec().draw_text(
+                "no samples recorded",
+                &style,
+                (w as i32 / 2, h as i32 / 2),
+            )?;
+        } else {
+            chart.draw_series(LineSeries::new(points, FORCE_COLOUR.stroke_width(1)))?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(t: f64, f: f64) -> OrbitSample {
+        OrbitSample {
+            t_s: t,
+            x_rel_m: 0.0,
+            y_rel_m: 0.0,
+            contact_force_n: f,
+        }
+    }
+
+    #[test]
+    fn extension_picks_format_case_insensitively() {
+        assert_eq!(
+            ImageFormat::from_path(Path::new("a/b.PNG")).unwrap(),
+            ImageFormat::Png
+        );
+        assert_eq!(
+            ImageFormat::from_path(Path::new("b.Svg")).unwrap(),
+            ImageFormat::Svg
+        );
+        for bad in ["c.jpg", "noext", "d.png.txt", ""] {
+            let err = ImageFormat::from_path(Path::new(bad)).unwrap_err();
+            assert!(
+                matches!(err, RenderError::UnsupportedExtension { .. }),
+                "{bad}"
+            );
+            assert!(err.to_string().contains(".png or .svg"));
+        }
+    }
+
+    #[test]
+    fn decimation_keeps_ends_and_peaks_within_budget() {
+        let n = 200_000;
+        let mut s: Vec<_> = (0..n).map(|i| sample(i as f64, 0.0)).collect();
+        s[12_345].contact_force_n = 5.0e3;
+        s[150_001].contact_force_n = f64::NAN;
+        s[150_002].contact_force_n = 7.0;
+        let d = decimate_samples(&s, 20_000);
+        assert!(d.len() <= 20_000, "{}", d.len());
+        assert_eq!(d.first().unwrap().t_s, 0.0);
+        assert_eq!(d.last().unwrap().t_s, (n - 1) as f64);
+        assert!(d.iter().any(|x| x.t_s == 12_345.0));
+        assert!(d.iter().any(|x| x.t_s == 150_002.0));
+        assert!(d.windows(2).all(|w| w[0].t_s < w[1].t_s));
+        assert_eq!(decimate_samples(&s[..10], 20_000).len(), 10);
+        assert!(decimate_samples(&s[..100], 0).len() <= 4);
+    }
+
+    #[test]
+    fn tick_labels_are_short() {
+        let f = tick_formatter(300.0);
+        assert_eq!(f(&-150.0), "-150");
+        assert_eq!(f(&1e-13), "0");
+        let f = tick_formatter(5.0);
+        assert_eq!(f(&2.5), "2.5");
+        assert_eq!(f(&2.0), "2");
+    }
+}

@@ -1,0 +1,203 @@
+//! End-to-end tests of the `whirlmap` binary: the JSON contract, bad input, scene files and
+//! charts.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn whirlmap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_whirlmap"))
+        .args(args)
+        .output()
+        .expect("runs the binary")
+}
+
+fn temp_path(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("whirlmap-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn json_output_parses_and_carries_every_contract_field() {
+    let out = whirlmap(&[
+        "drop",
+        "--speed-rpm",
+        "8000",
+        "--mu",
+        "0.3",
+        "--duration-s",
+        "0.05",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+    for key in [
+        "class",
+        "first_contact_force_n",
+        "max_contact_force_n",
+        "peak_friction_power_w",
+        "peak_heat_power_w",
+        "whirl_frequency_hz",
+        "contact_duty",
+        "impacts",
+        "end_time_s",
+        "stop_reason",
+        "energy",
+        "stats",
+        "scene_hash",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key} in {v}");
+    }
+    for key in [
+        "initial_j",
+        "final_j",
+        "friction_heat_j",
+        "damping_loss_j",
+        "drag_work_j",
+        "residual_rel",
+    ] {
+        assert!(v["energy"][key].is_number(), "energy.{key}");
+    }
+    for key in ["rhs_evals", "steps", "rejected", "events"] {
+        assert!(v["stats"][key].is_u64(), "stats.{key}");
+    }
+    let class = v["class"].as_str().unwrap();
+    assert!(
+        [
+            "pendulum",
+            "bouncing",
+            "backward_whirl",
+            "forward_whirl",
+            "unresolved"
+        ]
+        .contains(&class),
+        "{class}"
+    );
+    assert_eq!(v["stop_reason"], "duration_reached");
+    assert!((v["end_time_s"].as_f64().unwrap() - 0.05).abs() < 1e-12);
+    assert!(v["first_contact_force_n"].as_f64().unwrap() > 500.0);
+    assert_eq!(v["scene_hash"].as_str().unwrap().len(), 16);
+}
+
+#[test]
+fn bad_input_exits_2_naming_field_value_and_range() {
+    let cases: &[(&[&str], &[&str])] = &[
+        (&["--mu", "2.5"], &["mu_dynamic", "2.5", "[0, 2]"]),
+        (&["--mu", "-0.1"], &["mu_dynamic", "-0.1"]),
+        (&["--mu", "NaN"], &["mu_dynamic", "NaN"]),
+        (&["--duration-s", "0"], &["duration_s", "0", "(0, 3600]"]),
+        (&["--duration-s", "-1"], &["duration_s", "-1"]),
+        (
+            &["--set", "rotor_mass_kg=0"],
+            &["rotor_mass_kg", "0", "> 0"],
+        ),
+        (&["--set", "race_mass_kg=-1"], &["race_mass_kg", "-1"]),
+        (&["--set", "clearance_m=0"], &["clearance_m", "(0, 0.1]"]),
+        (
+            &["--set", "contact_stiffness_n_per_m_e=-5"],
+            &["contact_stiffness_n_per_m_e", "-5"],
+        ),
+        (
+            &["--set", "support_stiffness_n_per_m_e=0"],
+            &["support_stiffness_n_per_m_e"],
+        ),
+        (&["--set", "no_such_key=1"], &["no_such_key", "unknown"]),
+        (&["--set", "rotor_mass_kg=heavy"], &["rotor_mass_kg"]),
+        (
+            &["--scene", "/nonexistent/scene.json"],
+            &["/nonexistent/scene.json"],
+        ),
+        (&["--orbit", "chart.pdf"], &[".png or .svg"]),
+    ];
+    for (args, needles) in cases {
+        let mut full = vec!["drop"];
+        full.extend_from_slice(args);
+        let out = whirlmap(&full);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        for n in *needles {
+            assert!(err.contains(n), "{args:?}: message `{err}` lacks `{n}`");
+        }
+        assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    }
+}
+
+#[test]
+fn scene_file_with_unknown_key_reports_line_and_column() {
+    let p = temp_path("typo.json");
+    std::fs::write(
+        &p,
+        "{\n  \"speed_rpm\": 5000,\n  \"clearence_m\": 1e-4\n}\n",
+    )
+    .unwrap();
+    let out = whirlmap(&["drop", "--scene", p.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("clearence_m") && err.contains("line 3"),
+        "{err}"
+    );
+}
+
+#[test]
+fn printed_scene_round_trips_through_a_scene_file() {
+    let out = whirlmap(&["scene"]);
+    assert!(out.status.success());
+    let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["clearance_m"], 0.00015);
+    v["speed_rpm"] = serde_json::json!(3000.0);
+    let p = temp_path("scene.json");
+    std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
+    let a = whirlmap(&[
+        "drop",
+        "--scene",
+        p.to_str().unwrap(),
+        "--duration-s",
+        "0.02",
+        "--json",
+    ]);
+    let b = whirlmap(&[
+        "drop",
+        "--speed-rpm",
+        "3000",
+        "--duration-s",
+        "0.02",
+        "--json",
+    ]);
+    assert!(a.status.success() && b.status.success());
+    assert_eq!(
+        a.stdout, b.stdout,
+        "scene file and flags give the same drop"
+    );
+}
+
+#[test]
+fn orbit_option_draws_a_well_formed_svg() {
+    let p = temp_path("orbit.svg");
+    let out = whirlmap(&[
+        "drop",
+        "--mu",
+        "0.2",
+        "--duration-s",
+        "0.03",
+        "--orbit",
+        p.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let svg = std::fs::read_to_string(&p).unwrap();
+    assert!(svg.contains("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert!(svg.contains("contact force"));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("class") && text.contains("first contact force"),
+        "{text}"
+    );
+}
