@@ -4,14 +4,18 @@
 use crate::error::{InvalidParameter, SolveError};
 use crate::model::{ix, DropSystem, Mode, Slip, N};
 use crate::monitor::{Features, Monitor};
-use crate::ode::{integrate, Dopri5, Stats, StepControl, Stop};
+use crate::ode::{integrate, Dopri5, NoObserver, Observer, Stats, StepControl, StepView, Stop};
 use crate::orbit::Orbit;
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
+use std::ops::ControlFlow;
 
 /// Version of the model and its outputs; part of every record key. Bump it when a change
 /// alters results for the same scene.
 pub const MODEL_VERSION: u32 = 1;
+
+/// Largest first step after a mode switch (s): see [`Dopri5::cap_next_step`].
+const STEP_AFTER_SWITCH_S: f64 = 1e-7;
 
 /// How to run a drop (what is not physics).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -113,6 +117,21 @@ pub struct DropReport {
     pub orbit: Option<Orbit>,
     /// Stable hash of the scene (16 hex digits).
     pub scene_hash: String,
+    /// The state at the end (layout in [`crate::model::ix`]).
+    pub final_state: [f64; N],
+}
+
+/// Passes every step to an extra observer, then to the monitor (which alone may stop).
+struct Tap<'a, O> {
+    extra: &'a mut O,
+    mon: &'a mut Monitor,
+}
+
+impl<O: Observer<DropSystem, N>> Observer<DropSystem, N> for Tap<'_, O> {
+    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
+        let _ = self.extra.on_step(sys, step);
+        self.mon.on_step(sys, step)
+    }
 }
 
 /// Per-component absolute tolerances: displacements to `rtol * position_scale_m`, speeds and
@@ -177,6 +196,16 @@ fn next_mode(sys: &DropSystem, y: &[f64; N], index: usize) -> Mode {
 
 /// Simulates one drop of `scene` under `opts`.
 pub fn simulate(scene: &Scene, opts: &DropOptions) -> Result<DropReport, SolveError> {
+    simulate_observed(scene, opts, &mut NoObserver)
+}
+
+/// [`simulate`], also showing every accepted step (with the system in its current mode) to
+/// `extra`: for diagnostics and invariant checks along a run. `extra` cannot stop the run.
+pub fn simulate_observed<O: Observer<DropSystem, N>>(
+    scene: &Scene,
+    opts: &DropOptions,
+    extra: &mut O,
+) -> Result<DropReport, SolveError> {
     scene.validate()?;
     opts.validate()?;
     let mut sys = DropSystem::new(scene);
@@ -195,13 +224,17 @@ pub fn simulate(scene: &Scene, opts: &DropOptions) -> Result<DropReport, SolveEr
     let mut t = 0.0;
     let mut switch_loss = 0.0;
     let stop_reason = loop {
+        let mut tap = Tap {
+            extra: &mut *extra,
+            mon: &mut mon,
+        };
         match integrate(
             &sys,
             &mut stepper,
             &mut t,
             &mut y,
             opts.duration_s,
-            &mut mon,
+            &mut tap,
         )? {
             Stop::EndTime => break StopReason::DurationReached,
             Stop::Observer => break StopReason::WhirlTurnsReached,
@@ -220,6 +253,7 @@ pub fn simulate(scene: &Scene, opts: &DropOptions) -> Result<DropReport, SolveEr
                 }
                 sys.mode = new;
                 mon.mode_switched();
+                stepper.cap_next_step(STEP_AFTER_SWITCH_S);
             }
         }
     };
@@ -251,5 +285,6 @@ pub fn simulate(scene: &Scene, opts: &DropOptions) -> Result<DropReport, SolveEr
         stop_reason,
         orbit,
         scene_hash: scene.hash_hex(),
+        final_state: y,
     })
 }

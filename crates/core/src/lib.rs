@@ -48,7 +48,9 @@ pub mod ode;
 pub mod orbit;
 pub mod scene;
 
-pub use drop::{simulate, DropOptions, DropReport, EnergyAudit, StopReason, MODEL_VERSION};
+pub use drop::{
+    simulate, simulate_observed, DropOptions, DropReport, EnergyAudit, StopReason, MODEL_VERSION,
+};
 pub use error::{InvalidParameter, SolveError};
 pub use monitor::{Features, Window};
 pub use scene::{FrictionLaw, Scene, SolverSettings};

@@ -41,8 +41,6 @@ pub trait OdeSystem<const N: usize> {
 pub struct StepView<'a, const N: usize> {
     /// The step's interpolant over `[t0, t1]`.
     pub dense: &'a Dense<N>,
-    /// Derivative at `t1` (exact RHS value, not interpolated).
-    pub dy1: &'a [f64; N],
 }
 
 /// Receives every accepted step; may ask the integrator to stop.
@@ -111,22 +109,32 @@ where
         let t1 = dense.t1();
         let y1 = dense.y1();
         sys.guards(t1, &y1, &mut g1);
+        // Guards are also checked at the step's midpoint on the interpolant, so a mode that
+        // ends and resumes inside one step (a grazing contact that opens and closes again)
+        // is not missed; a crossing in the first half wins over one in the second.
+        let tm = 0.5 * (dense.t0() + t1);
+        let mut gm = [0.0; MAX_GUARDS];
+        sys.guards(tm, &dense.eval(tm), &mut gm);
+        let guard_at = |i: usize, tt: f64| {
+            let mut g = [0.0; MAX_GUARDS];
+            sys.guards(tt, &dense.eval(tt), &mut g);
+            g[i]
+        };
         // Earliest guard to cross to <= 0 within the step.
         let mut first: Option<(usize, f64, f64)> = None;
         for i in 0..ng {
-            if g0[i] > 0.0 && g1[i] <= 0.0 {
-                let (lo, hi) = locate_crossing(
-                    |tt| {
-                        let yy = dense.eval(tt);
-                        let mut g = [0.0; MAX_GUARDS];
-                        sys.guards(tt, &yy, &mut g);
-                        g[i]
-                    },
-                    dense.t0(),
-                    t1,
-                    g0[i],
-                    g1[i],
-                );
+            if g0[i] <= 0.0 {
+                continue;
+            }
+            let bracket = if gm[i] <= 0.0 {
+                Some((dense.t0(), tm, g0[i], gm[i]))
+            } else if g1[i] <= 0.0 {
+                Some((tm, t1, gm[i], g1[i]))
+            } else {
+                None
+            };
+            if let Some((a, b, ga, gb)) = bracket {
+                let (lo, hi) = locate_crossing(|tt| guard_at(i, tt), a, b, ga, gb);
                 if first.is_none_or(|(_, _, h)| hi < h) {
                     first = Some((i, lo, hi));
                 }
@@ -134,15 +142,12 @@ where
         }
         match first {
             Some((index, _lo, hi)) => {
-                let truncated = stepper.truncate(sys, hi);
-                let view = StepView {
-                    dense: &truncated.0,
-                    dy1: &truncated.1,
-                };
-                *t = hi;
-                *y = truncated.0.y1();
                 stepper.stats.events += 1;
-                // The observer still sees the truncated step; a break here is moot.
+                let cut = stepper.cut_last_step(hi);
+                *t = hi;
+                *y = cut.y1();
+                let view = StepView { dense: cut };
+                // The observer sees the step up to the event; a break here is moot.
                 let _ = observer.on_step(sys, &view);
                 return Ok(Stop::Event { index });
             }
@@ -152,7 +157,6 @@ where
                 g0 = g1;
                 let view = StepView {
                     dense: stepper.last_dense(),
-                    dy1: stepper.last_dy(),
                 };
                 if observer.on_step(sys, &view).is_break() {
                     return Ok(Stop::Observer);
