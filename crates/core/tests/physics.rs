@@ -9,7 +9,7 @@ use std::ops::ControlFlow;
 use whirlmap_core::model::friction::stick_or_slip;
 use whirlmap_core::model::{ix, DropSystem, Slip, N};
 use whirlmap_core::ode::{
-    integrate, Dopri5, Observer, OdeSystem, Stats, StepControl, StepView, Stop, MAX_GUARDS,
+    integrate, Dopri5, Observer, OdeSystem, StepControl, StepView, Stop, MAX_GUARDS,
 };
 use whirlmap_core::{
     simulate, simulate_observed, DropOptions, DropReport, Scene, SolveError, StopReason,
