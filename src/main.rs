@@ -16,6 +16,9 @@ use whirlmap_sweep::record::DropRecord;
 use whirlmap_sweep::render::{draw_orbit, ImageFormat};
 
 mod bench;
+mod critical_cmd;
+mod render_cmd;
+mod sweep_cmd;
 
 #[derive(Parser)]
 #[command(
@@ -36,6 +39,13 @@ enum Command {
     Scene,
     /// Time a pendulum drop, a whirl drop and one right-hand-side evaluation.
     Bench(bench::BenchArgs),
+    /// Draw the design charts (Figs. 3-6, class map) of a sweep's results directory into
+    /// DIR/charts/ as PNG and SVG (exit 2 if DIR has no points.jsonl, 4 if writing fails).
+    Render(render_cmd::RenderArgs),
+    /// Critical backward-whirl speed per friction coefficient (scan, then bisection).
+    Critical(critical_cmd::CriticalArgs),
+    /// Run a grid of drops from a JSON sweep spec (exit 1 if any point failed).
+    Sweep(sweep_cmd::SweepArgs),
 }
 
 #[derive(clap::Args)]
@@ -209,6 +219,12 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::Bench(a) => bench::run(a).map_err(Failure::Solve),
+        Command::Render(a) => render_cmd::run(a).map_err(|f| match f {
+            render_cmd::RenderFailure::Input(e) => Failure::Input(e),
+            render_cmd::RenderFailure::Output(e) => Failure::Output(e),
+        }),
+        Command::Critical(a) => critical_cmd::run(a),
+        Command::Sweep(a) => return sweep_cmd::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

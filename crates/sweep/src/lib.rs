@@ -4,10 +4,18 @@
 //! - [`record`]: the JSON record of one drop (the output contract).
 //! - [`overrides`]: scene parameters set by name (`--set key=value`, sweep axes).
 //! - [`render`] and [`fonts`]: charts with an embedded font (no system fonts needed).
+//! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
+//!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
+//! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
 #![warn(missing_docs)]
 
+pub mod charts;
 pub mod classify;
+pub mod critical;
+pub mod extras;
 pub mod fonts;
 pub mod overrides;
 pub mod record;
 pub mod render;
+pub mod spec;
+pub mod sweep;

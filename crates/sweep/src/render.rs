@@ -308,14 +308,20 @@ fn tick_formatter(span: f64) -> impl Fn(&f64) -> String {
             return "0".to_string();
         }
         if v.abs() >= 1e6 || span < 1e-4 {
-            return format!("{v:.2e}");
+            let s = format!("{v:.2e}");
+            let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+            return format!("{}e{exponent}", trim_decimal_zeros(mantissa));
         }
-        let s = format!("{v:.decimals$}");
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        }
+        trim_decimal_zeros(&format!("{v:.decimals$}")).to_string()
+    }
+}
+
+/// `"2.50"` to `"2.5"`, `"3.00"` to `"3"`; integers unchanged.
+fn trim_decimal_zeros(s: &str) -> &str {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s
     }
 }
 
@@ -335,11 +341,16 @@ fn format_quantity(value: f64) -> String {
     }
 }
 
-/// (min, max) of the finite values, or `None` if there are none.
+/// Largest magnitude an axis range reaches: keeps spans and padding finite (plotters hangs
+/// on infinite ranges) when a blown-up solution records values near `f64::MAX`.
+const AXIS_LIMIT: f64 = 1e300;
+
+/// (min, max) of the finite values, clamped to [`AXIS_LIMIT`], or `None` if there are none.
 fn finite_bounds(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
     values
         .into_iter()
         .filter(|v| v.is_finite())
+        .map(|v| v.clamp(-AXIS_LIMIT, AXIS_LIMIT))
         .fold(None, |acc, v| match acc {
             None => Some((v, v)),
             Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
@@ -388,6 +399,28 @@ fn draw_mesh<DB: DrawingBackend>(
         .light_line_style(GRID_LIGHT.stroke_width(1))
         .max_light_lines(4)
         .draw()
+}
+
+/// Draws `points` as a 1 px polyline, without gaps on bitmaps.
+///
+/// plotters' anti-aliased 1 px bitmap lines leave out some segment end pixels, which shows as
+/// gaps along dense paths, so on a bitmap backend every vertex is also set as a pixel. SVG
+/// lines are exact already (and a pixel there would be a `<rect>` each), so nothing is added.
+pub(crate) fn draw_thin_line<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    points: &[(f64, f64)],
+    colour: RGBColor,
+) -> DrawResult<DB> {
+    chart.draw_series(LineSeries::new(
+        points.iter().copied(),
+        colour.stroke_width(1),
+    ))?;
+    // `Figure::draw` is generic over the backend; its type name is the one place the
+    // raster/vector distinction is visible without widening that trait.
+    if std::any::type_name::<DB>().contains("BitMapBackend") {
+        chart.draw_series(points.iter().map(|&p| Pixel::new(p, colour)))?;
+    }
+    Ok(())
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -451,7 +484,7 @@ impl OrbitFigure<'_> {
             .chain(clearance)
             .fold(0.0_f64, f64::max);
         let extent = if extent > 0.0 && extent.is_finite() {
-            extent
+            extent.min(AXIS_LIMIT)
         } else {
             1.0
         };
@@ -489,10 +522,7 @@ impl OrbitFigure<'_> {
                 CLEARANCE_COLOUR.stroke_width(2),
             ))?;
         }
-        chart.draw_series(LineSeries::new(
-            path.iter().copied(),
-            PATH_COLOUR.stroke_width(1),
-        ))?;
+        draw_thin_line(&mut chart, &path, PATH_COLOUR)?;
         if let (Some(&first), Some(&last)) = (path.first(), path.last()) {
             chart.draw_series([
                 Circle::new(first, 5, START_COLOUR.filled()),
@@ -552,10 +582,68 @@ impl OrbitFigure<'_> {
                 (w as i32 / 2, h as i32 / 2),
             )?;
         } else {
-            chart.draw_series(LineSeries::new(points, FORCE_COLOUR.stroke_width(1)))?;
+            draw_thin_line(&mut chart, &points, FORCE_COLOUR)?;
         }
         Ok(())
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Crate-internal access to the shared styling helpers, for the design charts (`crate::charts`).
+
+/// Figure title font size (px), shared with [`crate::charts`].
+pub(crate) const CHART_TITLE_FONT: f64 = TITLE_FONT;
+/// Panel caption font size (px), shared with [`crate::charts`].
+pub(crate) const CHART_CAPTION_FONT: f64 = CAPTION_FONT;
+/// Axis description font size (px), shared with [`crate::charts`].
+pub(crate) const CHART_AXIS_DESC_FONT: f64 = AXIS_DESC_FONT;
+/// Tick label and legend font size (px), shared with [`crate::charts`].
+pub(crate) const CHART_TICK_FONT: f64 = TICK_FONT;
+/// Height of the title band (px), shared with [`crate::charts`].
+pub(crate) const CHART_TITLE_BAND: u32 = TITLE_BAND;
+/// Space below a plot for x ticks and description (px), shared with [`crate::charts`].
+pub(crate) const CHART_X_LABEL_AREA: u32 = X_LABEL_AREA;
+/// Space left of a plot for y ticks and description (px), shared with [`crate::charts`].
+pub(crate) const CHART_Y_LABEL_AREA: u32 = Y_LABEL_AREA;
+/// Clearance-circle colour, shared with [`crate::charts`].
+pub(crate) const CHART_CLEARANCE_COLOUR: RGBColor = CLEARANCE_COLOUR;
+/// Orbit path colour, shared with [`crate::charts`].
+pub(crate) const CHART_PATH_COLOUR: RGBColor = PATH_COLOUR;
+
+/// The embedded-font text style of `size` px in the chart text colour.
+pub(crate) fn chart_text_style(size: f64) -> TextStyle<'static> {
+    text_style(size)
+}
+
+/// Splits a titled band off the top of `area` (see `with_header`); returns the rest.
+pub(crate) fn chart_header<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    height: u32,
+    text: &str,
+    size: f64,
+) -> Result<DrawingArea<DB, Shift>, DrawingAreaErrorKind<DB::ErrorType>> {
+    with_header(area, height, text, size)
+}
+
+/// The common axis styling (see `draw_mesh`).
+pub(crate) fn chart_mesh<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    x_desc: &str,
+    y_desc: &str,
+    x_ticks: usize,
+    y_ticks: usize,
+) -> DrawResult<DB> {
+    draw_mesh(chart, x_desc, y_desc, x_ticks, y_ticks)
+}
+
+/// A short tick-label formatter for an axis spanning `span` (see `tick_formatter`).
+pub(crate) fn chart_tick_formatter(span: f64) -> impl Fn(&f64) -> String {
+    tick_formatter(span)
+}
+
+/// `value` with about three significant digits (see `format_quantity`).
+pub(crate) fn chart_quantity(value: f64) -> String {
+    format_quantity(value)
 }
 
 #[cfg(test)]
@@ -617,5 +705,8 @@ mod tests {
         let f = tick_formatter(5.0);
         assert_eq!(f(&2.5), "2.5");
         assert_eq!(f(&2.0), "2");
+        let f = tick_formatter(1e300);
+        assert_eq!(f(&8e299), "8e299");
+        assert_eq!(f(&-1.25e300), "-1.25e300");
     }
 }

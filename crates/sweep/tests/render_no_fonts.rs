@@ -163,6 +163,15 @@ fn empty_and_non_finite_orbits_still_render() {
     };
     draw_orbit(&dir.join("all_nan.svg"), "", &all_nan).expect("all-NaN svg");
     assert_svg(&dir.join("all_nan.svg"));
+
+    // A blown-up solution: huge but finite values must not panic or hang.
+    let mut huge = synthetic_orbit(50);
+    huge.samples[25].x_rel_m = 1e300;
+    huge.samples[26].y_rel_m = -f64::MAX;
+    huge.samples[27].contact_force_n = f64::MAX;
+    huge.samples[28].t_s = 1e300;
+    draw_orbit(&dir.join("huge.png"), "huge", &huge).expect("huge png");
+    assert_png(&dir.join("huge.png"), 5 * 1024);
     cleanup(&dir);
 }
 

@@ -1,0 +1,1638 @@
+//! Design charts from a sweep's results directory (the paper's Figs. 3 to 6 plus a class map).
+//!
+//! Reads `results/<name>/points.jsonl` (one JSON object per grid point; a torn last line is
+//! skipped), the optional `critical.json` (critical whirl speed per friction coefficient) and
+//! the optional `orbits/*.json`, and draws every chart whose data exists into `charts/` as
+//! both PNG and SVG with [`render_all`]. Drawing reuses [`crate::render`] (embedded font,
+//! shared styling), so charts render on machines without system fonts.
+//!
+//! Grid charts use two axes, release speed (`speed_rpm`) and friction (`mu`). If the sweep
+//! has further axes, the slice at each one's first value is charted and the title says so.
+//! Whirl cells are left out of the force and heat colour scales (as in the paper's Fig. 5) but
+//! hatched so their place stays visible; failed points are marked with a cross.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::ViridisRGB;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use serde::Deserialize;
+use serde_json::Value;
+use whirlmap_core::orbit::Orbit;
+
+use crate::classify::OrbitClass;
+use crate::render::{
+    chart_header, chart_mesh, chart_quantity, chart_text_style, chart_tick_formatter,
+    decimate_samples, render, DrawResult, Figure, RenderError, CHART_AXIS_DESC_FONT,
+    CHART_CAPTION_FONT, CHART_CLEARANCE_COLOUR, CHART_PATH_COLOUR, CHART_TICK_FONT,
+    CHART_TITLE_BAND, CHART_TITLE_FONT, CHART_X_LABEL_AREA, CHART_Y_LABEL_AREA,
+};
+
+/// Size (width, height) in pixels of the grid charts and Fig. 4.
+pub const CHART_SIZE: (u32, u32) = (1000, 700);
+
+/// The input names of the speed axis.
+const SPEED_KEYS: [&str; 1] = ["speed_rpm"];
+/// The input names of the friction axis (`mu` first).
+const MU_KEYS: [&str; 2] = ["mu", "mu_dynamic"];
+
+const SPEED_DESC: &str = "release speed (r/min)";
+const MU_DESC: &str = "friction coefficient µ (-)";
+
+/// Why charts could not be drawn.
+#[derive(Debug, thiserror::Error)]
+pub enum ChartError {
+    /// The results directory has no `points.jsonl`.
+    #[error("no sweep results: {} does not exist", path.display())]
+    NoPoints {
+        /// The missing file.
+        path: PathBuf,
+    },
+    /// An input file could not be read.
+    #[error("cannot read {}: {cause}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        cause: std::io::Error,
+    },
+    /// An input file is not what it should be (a torn last line of points.jsonl is not).
+    #[error("{}: line {line}: {message}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number (1 for whole-file JSON).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The charts directory could not be created.
+    #[error("cannot create {}: {cause}", path.display())]
+    Write {
+        /// The directory.
+        path: PathBuf,
+        /// The I/O error.
+        cause: std::io::Error,
+    },
+    /// A chart could not be drawn or saved.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+}
+
+impl ChartError {
+    /// Whether this is a failure to write output (as opposed to missing or bad input).
+    pub fn is_output(&self) -> bool {
+        matches!(self, ChartError::Write { .. } | ChartError::Render(_))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loading.
+
+/// Whether a grid point ran.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointStatus {
+    /// The drop finished and has a record.
+    Ok,
+    /// The drop failed (or the status is unknown).
+    Failed,
+}
+
+/// One line of `points.jsonl`, reduced to what the charts use.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointRow {
+    /// The point's stable key.
+    pub key: String,
+    /// The point's index in the sweep, if given.
+    pub index: Option<u64>,
+    /// The sweep inputs (`speed_rpm`, `mu`, ...), as written.
+    pub inputs: BTreeMap<String, Value>,
+    /// Whether the drop ran.
+    pub status: PointStatus,
+    /// Orbit class (ok points whose record names one).
+    pub class: Option<OrbitClass>,
+    /// Maximum contact force (N), if finite.
+    pub max_contact_force_n: Option<f64>,
+    /// Peak heat power (W), if finite.
+    pub peak_heat_power_w: Option<f64>,
+    /// The error of a failed point, as text.
+    pub error: Option<String>,
+}
+
+impl PointRow {
+    /// The numeric input under the first of `keys` present.
+    fn input(&self, keys: &[&str]) -> Option<f64> {
+        keys.iter()
+            .find_map(|k| self.inputs.get(*k))
+            .and_then(Value::as_f64)
+    }
+    /// Release speed (r/min), if an input.
+    pub fn speed_rpm(&self) -> Option<f64> {
+        self.input(&SPEED_KEYS)
+    }
+    /// Friction coefficient, if an input.
+    pub fn mu(&self) -> Option<f64> {
+        self.input(&MU_KEYS)
+    }
+}
+
+#[derive(Deserialize)]
+struct RawRow {
+    #[serde(default)]
+    key: Option<String>,
+    #[serde(default)]
+    index: Option<u64>,
+    #[serde(default)]
+    inputs: BTreeMap<String, Value>,
+    #[serde(default)]
+    status: Option<String>,
+    #[serde(default)]
+    record: Option<Value>,
+    #[serde(default)]
+    error: Option<Value>,
+}
+
+fn finite(v: Option<&Value>) -> Option<f64> {
+    v.and_then(Value::as_f64).filter(|x| x.is_finite())
+}
+
+impl From<RawRow> for PointRow {
+    fn from(r: RawRow) -> Self {
+        let ok = r.status.as_deref() == Some("ok") && r.record.is_some();
+        let rec = r.record.as_ref().filter(|_| ok);
+        let error = r.error.map(|e| match e {
+            Value::String(s) => s,
+            other => other
+                .get("message")
+                .and_then(Value::as_str)
+                .map(str::to_string)
+                .unwrap_or_else(|| other.to_string()),
+        });
+        PointRow {
+            key: r.key.unwrap_or_default(),
+            index: r.index,
+            inputs: r.inputs,
+            status: if ok {
+                PointStatus::Ok
+            } else {
+                PointStatus::Failed
+            },
+            class: rec
+                .and_then(|v| v.get("class"))
+                .and_then(|c| serde_json::from_value(c.clone()).ok()),
+            max_contact_force_n: finite(rec.and_then(|v| v.get("max_contact_force_n"))),
+            peak_heat_power_w: finite(rec.and_then(|v| v.get("peak_heat_power_w"))),
+            error,
+        }
+    }
+}
+
+/// Reads `dir/points.jsonl`. Blank lines are ignored and an unparseable last line (a write
+/// torn by a crash) is skipped; an unparseable line elsewhere is an error.
+pub fn load_points(dir: &Path) -> Result<Vec<PointRow>, ChartError> {
+    let path = dir.join("points.jsonl");
+    let bytes = match std::fs::read(&path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(ChartError::NoPoints { path })
+        }
+        Err(cause) => return Err(ChartError::Read { path, cause }),
+    };
+    let text = String::from_utf8_lossy(&bytes);
+    let lines: Vec<(usize, &str)> = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .collect();
+    let mut rows = Vec::with_capacity(lines.len());
+    for (k, (n, line)) in lines.iter().enumerate() {
+        match serde_json::from_str::<RawRow>(line) {
+            Ok(raw) => rows.push(PointRow::from(raw)),
+            Err(_) if k + 1 == lines.len() => {} // torn last line
+            Err(e) => {
+                return Err(ChartError::Parse {
+                    path,
+                    line: n + 1,
+                    message: e.to_string(),
+                })
+            }
+        }
+    }
+    Ok(rows)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Grid assembly.
+
+/// Grid points arranged over speed (x) and friction (y).
+#[derive(Debug, Clone)]
+pub struct Grid {
+    /// Distinct speeds (r/min), increasing.
+    pub speeds_rpm: Vec<f64>,
+    /// Distinct friction coefficients, increasing.
+    pub mus: Vec<f64>,
+    /// `cells[j * speeds_rpm.len() + i]`: the point at speed `i`, friction `j`, if any.
+    pub cells: Vec<Option<PointRow>>,
+    /// Every point of the charted slice (the same points as `cells`).
+    pub rows: Vec<PointRow>,
+    /// "slice at name = value, ..." when the sweep has further axes.
+    pub slice: Option<String>,
+}
+
+impl Grid {
+    /// The point at speed index `i` and friction index `j`.
+    pub fn cell(&self, i: usize, j: usize) -> Option<&PointRow> {
+        self.cells
+            .get(j * self.speeds_rpm.len() + i)
+            .and_then(Option::as_ref)
+    }
+}
+
+fn distinct_sorted(values: impl IntoIterator<Item = f64>) -> Vec<f64> {
+    let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1e-300));
+    v
+}
+
+fn position(axis: &[f64], x: f64) -> Option<usize> {
+    axis.iter()
+        .position(|a| (a - x).abs() <= 1e-9 * a.abs().max(x.abs()).max(1e-300))
+}
+
+fn format_input(v: &Value) -> String {
+    match v {
+        Value::Number(n) => n
+            .as_f64()
+            .map(|x| {
+                let s = format!("{x}");
+                if s.len() > 10 {
+                    format!("{x:.4e}")
+                } else {
+                    s
+                }
+            })
+            .unwrap_or_else(|| n.to_string()),
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// Arranges `rows` on the speed x friction grid. Further axes (inputs that take more than one
+/// value) are fixed at the value of the first point (lowest index), and [`Grid::slice`] says
+/// so. A missing speed or friction input counts as a single value (0). A point appearing
+/// twice (a rerun) is taken from its later line.
+pub fn assemble_grid(rows: &[PointRow]) -> Grid {
+    let mut first = rows.iter().collect::<Vec<_>>();
+    first.sort_by_key(|r| r.index.unwrap_or(u64::MAX));
+    let axis_keys: Vec<&str> = SPEED_KEYS.iter().chain(MU_KEYS.iter()).copied().collect();
+    let mut fixed: Vec<(String, Value)> = Vec::new();
+    let keys: std::collections::BTreeSet<&String> =
+        rows.iter().flat_map(|r| r.inputs.keys()).collect();
+    for key in keys {
+        if axis_keys.contains(&key.as_str()) {
+            continue;
+        }
+        let mut seen: Vec<&Value> = Vec::new();
+        for r in rows {
+            if let Some(v) = r.inputs.get(key) {
+                if !seen.contains(&v) {
+                    seen.push(v);
+                }
+            }
+        }
+        if seen.len() > 1 {
+            if let Some(v) = first.iter().find_map(|r| r.inputs.get(key)) {
+                fixed.push((key.clone(), v.clone()));
+            }
+        }
+    }
+    let slice: Vec<PointRow> = rows
+        .iter()
+        .filter(|r| fixed.iter().all(|(k, v)| r.inputs.get(k) == Some(v)))
+        .cloned()
+        .collect();
+    let speed = |r: &PointRow| r.speed_rpm().unwrap_or(0.0);
+    let mu = |r: &PointRow| r.mu().unwrap_or(0.0);
+    let speeds_rpm = distinct_sorted(slice.iter().map(speed));
+    let mus = distinct_sorted(slice.iter().map(mu));
+    let mut cells = vec![None; speeds_rpm.len() * mus.len()];
+    for r in &slice {
+        if let (Some(i), Some(j)) = (position(&speeds_rpm, speed(r)), position(&mus, mu(r))) {
+            cells[j * speeds_rpm.len() + i] = Some(r.clone());
+        }
+    }
+    let slice_note = (!fixed.is_empty()).then(|| {
+        let parts: Vec<String> = fixed
+            .iter()
+            .map(|(k, v)| format!("{k} = {}", format_input(v)))
+            .collect();
+        format!("slice at {}", parts.join(", "))
+    });
+    Grid {
+        speeds_rpm,
+        mus,
+        cells,
+        rows: slice,
+        slice: slice_note,
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Contours.
+
+/// Contour segments of `z` at `level` by marching squares.
+///
+/// `z[j * xs.len() + i]` is the value at `(xs[i], ys[j])`. Cells with a non-finite corner are
+/// skipped; saddles are resolved by the cell's mean. Crossings are interpolated linearly, and
+/// a crossing shared by two cells is computed identically in both, so closed contours join
+/// exactly.
+pub fn marching_squares(xs: &[f64], ys: &[f64], z: &[f64], level: f64) -> Vec<[(f64, f64); 2]> {
+    let (nx, ny) = (xs.len(), ys.len());
+    let mut out = Vec::new();
+    if nx < 2 || ny < 2 || z.len() < nx * ny || !level.is_finite() {
+        return out;
+    }
+    let at = |i: usize, j: usize| z[j * nx + i];
+    let cross = |p: (f64, f64, f64), q: (f64, f64, f64)| {
+        let t = (level - p.2) / (q.2 - p.2);
+        (p.0 + t * (q.0 - p.0), p.1 + t * (q.1 - p.1))
+    };
+    for j in 0..ny - 1 {
+        for i in 0..nx - 1 {
+            // a bottom-left, b bottom-right, c top-right, d top-left.
+            let a = (xs[i], ys[j], at(i, j));
+            let b = (xs[i + 1], ys[j], at(i + 1, j));
+            let c = (xs[i + 1], ys[j + 1], at(i + 1, j + 1));
+            let d = (xs[i], ys[j + 1], at(i, j + 1));
+            if ![a.2, b.2, c.2, d.2].iter().all(|v| v.is_finite()) {
+                continue;
+            }
+            let inside = |p: (f64, f64, f64)| p.2 >= level;
+            let (ia, ib, ic, id) = (inside(a), inside(b), inside(c), inside(d));
+            let bottom = (ia != ib).then(|| cross(a, b));
+            let right = (ib != ic).then(|| cross(b, c));
+            let top = (id != ic).then(|| cross(d, c));
+            let left = (ia != id).then(|| cross(a, d));
+            let hits: Vec<(f64, f64)> = [bottom, right, top, left].into_iter().flatten().collect();
+            match hits.len() {
+                2 => out.push([hits[0], hits[1]]),
+                4 => {
+                    let centre = (a.2 + b.2 + c.2 + d.2) / 4.0 >= level;
+                    let (bo, r, t, l) = (hits[0], hits[1], hits[2], hits[3]);
+                    if centre == ia {
+                        // a and c connected through the centre: cut off b and d.
+                        out.push([bo, r]);
+                        out.push([t, l]);
+                    } else {
+                        out.push([l, bo]);
+                        out.push([r, t]);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    out
+}
+
+/// About `target` round contour levels strictly inside (lo, hi).
+pub fn nice_levels(lo: f64, hi: f64, target: usize) -> Vec<f64> {
+    let span = hi - lo;
+    if !(span.is_finite() && span > 0.0) || target == 0 {
+        return Vec::new();
+    }
+    let raw = span / target as f64;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 2.5, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    let mut levels = Vec::new();
+    let mut k = (lo / step).floor();
+    loop {
+        let v = k * step;
+        if v >= hi - span * 1e-6 {
+            break;
+        }
+        if v > lo + span * 1e-6 {
+            levels.push(v);
+        }
+        k += 1.0;
+    }
+    levels
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shared drawing pieces.
+
+const WHITE_TEXT_BG: RGBColor = RGBColor(255, 255, 255);
+const WHIRL_BG: RGBColor = RGBColor(236, 236, 236);
+const HATCH: RGBColor = RGBColor(120, 120, 120);
+const FAILED_BG: RGBColor = RGBColor(252, 226, 226);
+const FAILED_MARK: RGBColor = RGBColor(170, 20, 20);
+const CONTOUR: RGBColor = RGBColor(25, 25, 25);
+const BAND: RGBColor = RGBColor(214, 39, 40);
+
+/// The colour of each class on the class map and Fig. 4.
+fn class_colour(c: OrbitClass) -> RGBColor {
+    match c {
+        OrbitClass::Pendulum => RGBColor(31, 119, 180),
+        OrbitClass::Bouncing => RGBColor(255, 157, 40),
+        OrbitClass::BackwardWhirl => RGBColor(214, 39, 40),
+        OrbitClass::ForwardWhirl => RGBColor(148, 103, 189),
+        OrbitClass::Unresolved => RGBColor(175, 175, 175),
+    }
+}
+
+const ALL_CLASSES: [OrbitClass; 5] = [
+    OrbitClass::Pendulum,
+    OrbitClass::Bouncing,
+    OrbitClass::BackwardWhirl,
+    OrbitClass::ForwardWhirl,
+    OrbitClass::Unresolved,
+];
+
+/// A legend entry's mark.
+#[derive(Clone, Copy)]
+enum Mark {
+    Swatch(RGBColor),
+    Hatch(bool),
+    Failed,
+    Line(RGBColor),
+    Dashed(RGBColor),
+    Dot(RGBColor),
+    Band,
+    Arrow,
+    Diamond,
+}
+
+/// Draws hatch lines (45 degrees; the other diagonal if `forward`) in a pixel rectangle.
+fn hatch<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x0, y0): (i32, i32),
+    (x1, y1): (i32, i32),
+    forward: bool,
+) -> DrawResult<DB> {
+    const STEP: i32 = 9;
+    let style = HATCH.stroke_width(1);
+    let (w, h) = (x1 - x0, y1 - y0);
+    let mut c = -h;
+    while c <= w {
+        // Line through (x0 + c + t, y1 - t) (or mirrored), clipped to the rectangle.
+        let t0 = (-c).max(0);
+        let t1 = (w - c).min(h);
+        if t0 < t1 {
+            let p = |t: i32| {
+                if forward {
+                    (x0 + c + t, y0 + t)
+                } else {
+                    (x0 + c + t, y1 - t)
+                }
+            };
+            area.draw(&PathElement::new(vec![p(t0), p(t1)], style))?;
+        }
+        c += STEP;
+    }
+    Ok(())
+}
+
+/// Draws the failed-point cross centred at `(cx, cy)` with half-size `r` px.
+fn cross<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (cx, cy): (i32, i32),
+    r: i32,
+) -> DrawResult<DB> {
+    let style = FAILED_MARK.stroke_width(2);
+    area.draw(&PathElement::new(
+        vec![(cx - r, cy - r), (cx + r, cy + r)],
+        style,
+    ))?;
+    area.draw(&PathElement::new(
+        vec![(cx - r, cy + r), (cx + r, cy - r)],
+        style,
+    ))
+}
+
+fn arrow<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x, y): (i32, i32),
+    up: bool,
+    colour: RGBColor,
+) -> DrawResult<DB> {
+    let s = if up { -1 } else { 1 };
+    area.draw(&PathElement::new(
+        vec![(x, y - s * 4), (x, y + s * 14)],
+        colour.stroke_width(2),
+    ))?;
+    area.draw(&Polygon::new(
+        vec![(x - 6, y + s * 12), (x + 6, y + s * 12), (x, y + s * 22)],
+        colour.filled(),
+    ))
+}
+
+/// Draws a legend centred in `area`: one row, or more if the entries do not fit its width.
+fn legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(Mark, String)],
+) -> DrawResult<DB> {
+    const MARK_W: i32 = 26;
+    const GAP: i32 = 7;
+    const ENTRY_GAP: i32 = 26;
+    let style = chart_text_style(CHART_TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center));
+    let mut widths = Vec::new();
+    for (_, label) in entries {
+        widths.push(MARK_W + GAP + area.estimate_text_size(label, &style)?.0 as i32);
+    }
+    let (w, h) = area.dim_in_pixel();
+    let max_w = (w as f64 * 0.96) as i32;
+    // Greedy rows of entry indices.
+    let mut rows: Vec<Vec<usize>> = vec![Vec::new()];
+    let mut row_w = 0;
+    for (k, ew) in widths.iter().enumerate() {
+        let last = rows.last_mut().expect("one row");
+        let add = if last.is_empty() { *ew } else { ENTRY_GAP + ew };
+        if !last.is_empty() && row_w + add > max_w {
+            rows.push(vec![k]);
+            row_w = *ew;
+        } else {
+            last.push(k);
+            row_w += add;
+        }
+    }
+    let n_rows = rows.len() as i32;
+    for (r, row) in rows.iter().enumerate() {
+        let total: i32 =
+            row.iter().map(|&k| widths[k]).sum::<i32>() + ENTRY_GAP * (row.len() as i32 - 1);
+        let y = (h as i32 * (2 * r as i32 + 1)) / (2 * n_rows);
+        let mut x = (w as i32 - total).max(0) / 2;
+        for &k in row {
+            let (mark, label) = &entries[k];
+            draw_mark(area, *mark, x, y, MARK_W)?;
+            area.draw_text(label, &style, (x + MARK_W + GAP, y))?;
+            x += widths[k] + ENTRY_GAP;
+        }
+    }
+    Ok(())
+}
+
+/// Draws one legend mark, `mark_w` px wide, starting at `x`, centred on `y`.
+fn draw_mark<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    mark: Mark,
+    x: i32,
+    y: i32,
+    mark_w: i32,
+) -> DrawResult<DB> {
+    let (bx0, by0, bx1, by1) = (x + 2, y - 8, x + mark_w - 2, y + 8);
+    let border = RGBColor(110, 110, 110).stroke_width(1);
+    match mark {
+        Mark::Swatch(c) => {
+            area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], c.filled()))?;
+            area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], border))?;
+        }
+        Mark::Hatch(forward) => {
+            area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], WHIRL_BG.filled()))?;
+            hatch(area, (bx0, by0), (bx1, by1), forward)?;
+            area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], border))?;
+        }
+        Mark::Failed => {
+            area.draw(&Rectangle::new(
+                [(bx0, by0), (bx1, by1)],
+                FAILED_BG.filled(),
+            ))?;
+            cross(area, (x + mark_w / 2, y), 5)?;
+            area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], border))?;
+        }
+        Mark::Line(c) => area.draw(&PathElement::new(
+            vec![(x, y), (x + mark_w, y)],
+            c.stroke_width(2),
+        ))?,
+        Mark::Dashed(c) => area.draw(&DashedPathElement::new(
+            vec![(x, y), (x + mark_w, y)],
+            7,
+            4,
+            c.stroke_width(2),
+        ))?,
+        Mark::Dot(c) => {
+            area.draw(&Circle::new((x + mark_w / 2, y), 6, c.filled()))?;
+            area.draw(&Circle::new((x + mark_w / 2, y), 6, WHITE.stroke_width(1)))?;
+        }
+        Mark::Band => {
+            area.draw(&Rectangle::new(
+                [(bx0, by0), (bx1, by1)],
+                BAND.mix(0.22).filled(),
+            ))?;
+            area.draw(&PathElement::new(
+                vec![(x + mark_w / 2, by0), (x + mark_w / 2, by1)],
+                BAND.stroke_width(3),
+            ))?;
+        }
+        Mark::Arrow => arrow(area, (x + mark_w / 2, y + 9), true, RGBColor(60, 60, 60))?,
+        Mark::Diamond => area.draw(&Polygon::new(
+            vec![(x + 13, y - 7), (x + 20, y), (x + 13, y + 7), (x + 6, y)],
+            RGBColor(60, 60, 60).filled(),
+        ))?,
+    }
+    Ok(())
+}
+
+/// Cell edges around increasing centres: midpoints, extended by half a step at the ends.
+fn edges(centres: &[f64]) -> Vec<f64> {
+    match centres.len() {
+        0 => vec![0.0, 1.0],
+        1 => {
+            let c = centres[0];
+            let h = if c == 0.0 { 0.5 } else { c.abs() * 0.05 };
+            vec![c - h, c + h]
+        }
+        n => {
+            let mut e = Vec::with_capacity(n + 1);
+            e.push(centres[0] - (centres[1] - centres[0]) / 2.0);
+            for k in 0..n - 1 {
+                e.push((centres[k] + centres[k + 1]) / 2.0);
+            }
+            e.push(centres[n - 1] + (centres[n - 1] - centres[n - 2]) / 2.0);
+            e
+        }
+    }
+}
+
+fn with_slice(title: &str, slice: &Option<String>) -> String {
+    match slice {
+        Some(s) => format!("{title} ({s})"),
+        None => title.to_string(),
+    }
+}
+
+/// Draws `text` with a white box behind it, centred at pixel `(x, y)` of `area`.
+fn boxed_text<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    (x, y): (i32, i32),
+    size: f64,
+    colour: RGBColor,
+) -> DrawResult<DB> {
+    let style = chart_text_style(size)
+        .color(&colour)
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    let (w, h) = area.estimate_text_size(text, &style)?;
+    let (w, h) = (w as i32 / 2 + 3, h as i32 / 2 + 1);
+    area.draw(&Rectangle::new(
+        [(x - w, y - h), (x + w, y + h)],
+        WHITE_TEXT_BG.mix(0.85).filled(),
+    ))?;
+    area.draw_text(text, &style, (x, y))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Grid charts: heatmaps (Figs. 5 and 6) and the class map.
+
+#[derive(Clone, Copy, PartialEq)]
+enum CellKind {
+    Empty,
+    Failed,
+    Whirl(OrbitClass),
+    Value(f64),
+    Class(OrbitClass),
+    NoValue,
+}
+
+/// What the grid charts draw per cell.
+#[derive(Clone, Copy)]
+enum GridMode {
+    /// A metric in a colour scale, whirl left out.
+    Metric(fn(&PointRow) -> Option<f64>),
+    /// The class colour.
+    Classes,
+}
+
+struct GridFigure<'a> {
+    grid: &'a Grid,
+    title: String,
+    mode: GridMode,
+    bar_label: &'static str,
+}
+
+impl GridFigure<'_> {
+    fn kind(&self, i: usize, j: usize) -> CellKind {
+        let Some(row) = self.grid.cell(i, j) else {
+            return CellKind::Empty;
+        };
+        if row.status == PointStatus::Failed {
+            return CellKind::Failed;
+        }
+        let Some(class) = row.class else {
+            return CellKind::NoValue;
+        };
+        match self.mode {
+            GridMode::Classes => CellKind::Class(class),
+            GridMode::Metric(_) if class.is_whirl() => CellKind::Whirl(class),
+            GridMode::Metric(f) => f(row).map_or(CellKind::NoValue, CellKind::Value),
+        }
+    }
+}
+
+impl Figure for GridFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let g = self.grid;
+        let (nx, ny) = (g.speeds_rpm.len(), g.mus.len());
+        let kinds: Vec<CellKind> = (0..ny)
+            .flat_map(|j| (0..nx).map(move |i| (i, j)))
+            .map(|(i, j)| self.kind(i, j))
+            .collect();
+        let values: Vec<f64> = kinds
+            .iter()
+            .filter_map(|k| match k {
+                CellKind::Value(v) => Some(*v),
+                _ => None,
+            })
+            .collect();
+        let scale = values
+            .iter()
+            .fold(None, |acc: Option<(f64, f64)>, &v| match acc {
+                None => Some((v, v)),
+                Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+            });
+        let scale = scale.map(|(lo, hi)| {
+            if hi > lo {
+                (lo, hi)
+            } else {
+                let h = if lo == 0.0 { 1.0 } else { lo.abs() * 0.05 };
+                (lo - h, hi + h)
+            }
+        });
+        let is_metric = matches!(self.mode, GridMode::Metric(_));
+
+        let body = chart_header(root, CHART_TITLE_BAND, &self.title, CHART_TITLE_FONT)?;
+        let (bw, bh) = body.dim_in_pixel();
+        let (main, legend_band) = body.split_vertically(bh.saturating_sub(44));
+        let (plot_area, bar_area) = if is_metric {
+            main.split_horizontally(bw.saturating_sub(150))
+        } else {
+            main.split_horizontally(bw.saturating_sub(30))
+        };
+        let (xe, ye) = (edges(&g.speeds_rpm), edges(&g.mus));
+        let mut chart = ChartBuilder::on(&plot_area)
+            .margin_top(12)
+            .margin_left(14)
+            .margin_right(12)
+            .margin_bottom(4)
+            .x_label_area_size(CHART_X_LABEL_AREA)
+            .y_label_area_size(CHART_Y_LABEL_AREA)
+            .build_cartesian_2d(xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1])?;
+        chart_mesh(&mut chart, SPEED_DESC, MU_DESC, 10, 8)?;
+
+        let pa = chart.plotting_area();
+        let base = pa.get_base_pixel();
+        let px = |x: f64, y: f64| {
+            let p = chart.backend_coord(&(x, y));
+            (p.0 - base.0, p.1 - base.1)
+        };
+        let canvas = pa.strip_coord_spec();
+        let (mut any_failed, mut any_empty) = (false, false);
+        let mut whirl_seen = [false, false];
+        for j in 0..ny {
+            for i in 0..nx {
+                let tl = px(xe[i], ye[j + 1]);
+                let br = px(xe[i + 1], ye[j]);
+                let centre = ((tl.0 + br.0) / 2, (tl.1 + br.1) / 2);
+                let r = ((br.0 - tl.0).min(br.1 - tl.1) / 5).clamp(4, 12);
+                match kinds[j * nx + i] {
+                    CellKind::Value(v) => {
+                        let (lo, hi) = scale.unwrap_or((0.0, 1.0));
+                        let c = ViridisRGB::get_color_normalized(v, lo, hi);
+                        canvas.draw(&Rectangle::new([tl, br], c.filled()))?;
+                    }
+                    CellKind::Class(c) => {
+                        canvas.draw(&Rectangle::new([tl, br], class_colour(c).filled()))?;
+                    }
+                    CellKind::Whirl(c) => {
+                        let forward = c == OrbitClass::ForwardWhirl;
+                        whirl_seen[forward as usize] = true;
+                        canvas.draw(&Rectangle::new([tl, br], WHIRL_BG.filled()))?;
+                        hatch(&canvas, tl, br, forward)?;
+                    }
+                    CellKind::Failed => {
+                        any_failed = true;
+                        canvas.draw(&Rectangle::new([tl, br], FAILED_BG.filled()))?;
+                        cross(&canvas, centre, r)?;
+                    }
+                    CellKind::NoValue | CellKind::Empty => {
+                        any_empty = true;
+                    }
+                }
+                if kinds[j * nx + i] != CellKind::Empty {
+                    canvas.draw(&Rectangle::new([tl, br], WHITE.stroke_width(1)))?;
+                }
+            }
+        }
+
+        let mut levels = Vec::new();
+        if let (GridMode::Metric(_), Some((lo, hi))) = (self.mode, scale) {
+            if values.len() >= 2 {
+                levels = nice_levels(lo, hi, 6);
+            }
+            let z: Vec<f64> = kinds
+                .iter()
+                .map(|k| match k {
+                    CellKind::Value(v) => *v,
+                    _ => f64::NAN,
+                })
+                .collect();
+            for &level in &levels {
+                let segs = marching_squares(&g.speeds_rpm, &g.mus, &z, level);
+                for s in &segs {
+                    canvas.draw(&PathElement::new(
+                        vec![px(s[0].0, s[0].1), px(s[1].0, s[1].1)],
+                        CONTOUR.mix(0.8).stroke_width(2),
+                    ))?;
+                }
+                // Label the level once, on its longest segment.
+                let longest = segs.iter().max_by(|a, b| {
+                    let len = |s: &[(f64, f64); 2]| {
+                        let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
+                        (((p.0 - q.0).pow(2) + (p.1 - q.1).pow(2)) as f64).sqrt()
+                    };
+                    len(a).total_cmp(&len(b))
+                });
+                let long_enough = |s: &&[(f64, f64); 2]| {
+                    let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
+                    (p.0 - q.0).pow(2) + (p.1 - q.1).pow(2) >= 24 * 24
+                };
+                if let Some(s) = longest.filter(long_enough) {
+                    let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
+                    boxed_text(
+                        &canvas,
+                        &chart_quantity(level),
+                        ((p.0 + q.0) / 2, (p.1 + q.1) / 2),
+                        13.0,
+                        CONTOUR,
+                    )?;
+                }
+            }
+            if values.is_empty() {
+                let (w, h) = canvas.dim_in_pixel();
+                boxed_text(
+                    &canvas,
+                    "no values in scale",
+                    (w as i32 / 2, h as i32 / 2),
+                    CHART_CAPTION_FONT,
+                    CONTOUR,
+                )?;
+            }
+        }
+
+        // Legend.
+        let mut entries: Vec<(Mark, String)> = Vec::new();
+        match self.mode {
+            GridMode::Classes => {
+                let present: Vec<OrbitClass> = ALL_CLASSES.to_vec();
+                for c in present {
+                    entries.push((Mark::Swatch(class_colour(c)), c.label().to_string()));
+                }
+                entries.push((Mark::Failed, "failed".to_string()));
+            }
+            GridMode::Metric(_) => {
+                if !levels.is_empty() {
+                    entries.push((Mark::Line(CONTOUR), "contour lines".to_string()));
+                }
+                // The backward-whirl entry is always shown: it is where the scale stops.
+                entries.push((
+                    Mark::Hatch(false),
+                    "backward whirl (not in scale)".to_string(),
+                ));
+                if whirl_seen[1] {
+                    entries.push((
+                        Mark::Hatch(true),
+                        "forward whirl (not in scale)".to_string(),
+                    ));
+                }
+                if any_failed {
+                    entries.push((Mark::Failed, "failed".to_string()));
+                }
+            }
+        }
+        if any_empty {
+            entries.push((Mark::Swatch(WHITE), "no data".to_string()));
+        }
+        legend(&legend_band, &entries)?;
+
+        if let (GridMode::Metric(_), Some((lo, hi))) = (self.mode, scale) {
+            draw_colour_bar(&bar_area, lo, hi, &levels, self.bar_label)?;
+        }
+        Ok(())
+    }
+}
+
+fn draw_colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    lo: f64,
+    hi: f64,
+    levels: &[f64],
+    label: &str,
+) -> DrawResult<DB> {
+    let mut bar = ChartBuilder::on(area)
+        .margin_top(12)
+        .margin_bottom(4 + CHART_X_LABEL_AREA)
+        .margin_left(8)
+        .margin_right(4)
+        .right_y_label_area_size(96)
+        .build_cartesian_2d(0.0..1.0, lo..hi)?;
+    let fmt = chart_tick_formatter(hi - lo);
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(8)
+        .y_label_formatter(&fmt)
+        .y_desc(label)
+        .label_style(chart_text_style(CHART_TICK_FONT))
+        .axis_desc_style(chart_text_style(CHART_AXIS_DESC_FONT))
+        .axis_style(RGBColor(90, 90, 90).stroke_width(1))
+        .draw()?;
+    const STEPS: usize = 128;
+    bar.draw_series((0..STEPS).map(|k| {
+        let a = lo + (hi - lo) * k as f64 / STEPS as f64;
+        let b = lo + (hi - lo) * (k + 1) as f64 / STEPS as f64;
+        let c = ViridisRGB::get_color_normalized((a + b) / 2.0, lo, hi);
+        Rectangle::new([(0.0, a), (1.0, b)], c.filled())
+    }))?;
+    bar.draw_series(
+        levels
+            .iter()
+            .map(|&l| PathElement::new(vec![(0.0, l), (1.0, l)], CONTOUR.stroke_width(2))),
+    )?;
+    bar.draw_series([Rectangle::new(
+        [(0.0, lo), (1.0, hi)],
+        RGBColor(90, 90, 90).stroke_width(1),
+    )])?;
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fig. 4: critical whirl speed against friction.
+
+/// One friction coefficient's critical-speed search, from `critical.json`.
+#[derive(Debug, Clone, Deserialize)]
+pub struct CriticalEntry {
+    /// Friction coefficient.
+    pub mu: f64,
+    /// What the search found.
+    pub result: CriticalResult,
+}
+
+/// A critical-speed search result (the fields the chart uses; others are ignored).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(default)]
+pub struct CriticalResult {
+    /// The speeds (r/min) bracketing the onset of whirl, or `None` if no transition was
+    /// found within the scanned range.
+    pub bracket: Option<[f64; 2]>,
+    /// Class at the low end.
+    pub class_lo: Option<Value>,
+    /// Class at the high end.
+    pub class_hi: Option<Value>,
+    /// Drops the search ran.
+    pub drops_used: Option<u64>,
+    /// Whether the scan was not monotone (whirl, then no whirl, at higher speed).
+    pub non_monotone: bool,
+    /// Scanned (speed r/min, class) pairs.
+    pub scanned: Vec<(f64, Value)>,
+    /// Free-text remark.
+    pub note: Option<String>,
+}
+
+/// Reads `dir/critical.json`, or `None` if it does not exist.
+pub fn load_critical(dir: &Path) -> Result<Option<Vec<CriticalEntry>>, ChartError> {
+    let path = dir.join("critical.json");
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(cause) => return Err(ChartError::Read { path, cause }),
+    };
+    serde_json::from_str(&text)
+        .map(Some)
+        .map_err(|e| ChartError::Parse {
+            path,
+            line: e.line(),
+            message: e.to_string(),
+        })
+}
+
+fn is_whirl_value(v: &Value) -> Option<bool> {
+    serde_json::from_value::<OrbitClass>(v.clone())
+        .ok()
+        .map(OrbitClass::is_whirl)
+}
+
+/// Where the onset lies when no bracket was found: `Some(true)` above the scanned range
+/// (no whirl anywhere), `Some(false)` below it (whirl everywhere), `None` if undecided.
+fn no_transition_side(r: &CriticalResult) -> Option<bool> {
+    let whirls: Vec<bool> = r
+        .scanned
+        .iter()
+        .filter_map(|(_, c)| is_whirl_value(c))
+        .collect();
+    if !whirls.is_empty() {
+        if whirls.iter().all(|w| !w) {
+            return Some(true);
+        }
+        if whirls.iter().all(|w| *w) {
+            return Some(false);
+        }
+        return None;
+    }
+    let lo = r.class_lo.as_ref().and_then(is_whirl_value);
+    let hi = r.class_hi.as_ref().and_then(is_whirl_value);
+    match (lo, hi) {
+        (_, Some(false)) => Some(true),
+        (Some(true), _) => Some(false),
+        _ => None,
+    }
+}
+
+struct CriticalFigure<'a> {
+    entries: &'a [CriticalEntry],
+    grid: &'a Grid,
+    title: String,
+}
+
+impl Figure for CriticalFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let mut entries: Vec<&CriticalEntry> =
+            self.entries.iter().filter(|e| e.mu.is_finite()).collect();
+        entries.sort_by(|a, b| a.mu.total_cmp(&b.mu));
+        let points: Vec<(f64, f64, &PointRow)> = self
+            .grid
+            .rows
+            .iter()
+            .filter_map(|r| Some((r.mu()?, r.speed_rpm()?, r)))
+            .collect();
+
+        let mus = entries
+            .iter()
+            .map(|e| e.mu)
+            .chain(points.iter().map(|p| p.0));
+        let speeds = entries
+            .iter()
+            .flat_map(|e| {
+                e.result
+                    .bracket
+                    .into_iter()
+                    .flatten()
+                    .chain(e.result.scanned.iter().map(|s| s.0))
+            })
+            .chain(points.iter().map(|p| p.1));
+        let bounds = |v: Vec<f64>| {
+            v.into_iter()
+                .filter(|x| x.is_finite())
+                .fold(None, |acc: Option<(f64, f64)>, x| {
+                    Some(acc.map_or((x, x), |(lo, hi)| (lo.min(x), hi.max(x))))
+                })
+        };
+        let pad = |b: Option<(f64, f64)>, f: f64| match b {
+            None => (0.0, 1.0),
+            Some((lo, hi)) if hi > lo => (lo - (hi - lo) * f, hi + (hi - lo) * f),
+            Some((lo, _)) => (lo - lo.abs().max(1.0) * 0.1, lo + lo.abs().max(1.0) * 0.1),
+        };
+        let (x0, x1) = pad(bounds(mus.collect()), 0.1);
+        let (y0, y1) = pad(bounds(speeds.collect()), 0.15);
+        // Range ends for the "no transition" markers: the scanned range, else the grid's.
+        let grid_speed = bounds(points.iter().map(|p| p.1).collect());
+
+        let body = chart_header(root, CHART_TITLE_BAND, &self.title, CHART_TITLE_FONT)?;
+        let (_, bh) = body.dim_in_pixel();
+        let (plot_area, legend_band) = body.split_vertically(bh.saturating_sub(60));
+        let mut chart = ChartBuilder::on(&plot_area)
+            .margin_top(12)
+            .margin_left(14)
+            .margin_right(34)
+            .margin_bottom(4)
+            .x_label_area_size(CHART_X_LABEL_AREA)
+            .y_label_area_size(CHART_Y_LABEL_AREA)
+            .build_cartesian_2d(x0..x1, y0..y1)?;
+        chart_mesh(&mut chart, MU_DESC, "critical whirl speed (r/min)", 10, 8)?;
+
+        // The bracket band, over runs of neighbouring mu values that all have a bracket.
+        let mut run: Vec<(f64, f64, f64)> = Vec::new();
+        let mut runs = Vec::new();
+        for e in &entries {
+            match e.result.bracket {
+                Some([lo, hi]) if lo.is_finite() && hi.is_finite() => {
+                    run.push((e.mu, lo.min(hi), lo.max(hi)))
+                }
+                _ => runs.push(std::mem::take(&mut run)),
+            }
+        }
+        runs.push(run);
+        for run in runs.iter().filter(|r| r.len() >= 2) {
+            let poly: Vec<(f64, f64)> = run
+                .iter()
+                .map(|p| (p.0, p.1))
+                .chain(run.iter().rev().map(|p| (p.0, p.2)))
+                .collect();
+            chart.draw_series([Polygon::new(poly, BAND.mix(0.18).filled())])?;
+            chart.draw_series([
+                PathElement::new(
+                    run.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>(),
+                    BAND.mix(0.6).stroke_width(1),
+                ),
+                PathElement::new(
+                    run.iter().map(|p| (p.0, p.2)).collect::<Vec<_>>(),
+                    BAND.mix(0.6).stroke_width(1),
+                ),
+            ])?;
+        }
+
+        // Grid points, coloured by class.
+        let pa = chart.plotting_area();
+        let base = pa.get_base_pixel();
+        let px = |x: f64, y: f64| {
+            let p = chart.backend_coord(&(x, y));
+            (p.0 - base.0, p.1 - base.1)
+        };
+        let canvas = pa.strip_coord_spec();
+        let mut classes_seen = Vec::new();
+        let mut any_failed = false;
+        for (mu, speed, row) in &points {
+            let p = px(*mu, *speed);
+            match (row.status, row.class) {
+                (PointStatus::Ok, Some(c)) => {
+                    if !classes_seen.contains(&c) {
+                        classes_seen.push(c);
+                    }
+                    canvas.draw(&Circle::new(p, 6, class_colour(c).filled()))?;
+                    canvas.draw(&Circle::new(p, 6, WHITE.stroke_width(1)))?;
+                }
+                _ => {
+                    any_failed = true;
+                    cross(&canvas, p, 5)?;
+                }
+            }
+        }
+
+        // Brackets as error bars; no-transition markers at the range end.
+        let (mut any_arrow, mut any_nonmono) = (false, false);
+        for e in &entries {
+            let r = &e.result;
+            if let Some([lo, hi]) = r.bracket.filter(|b| b[0].is_finite() && b[1].is_finite()) {
+                let (a, b) = (px(e.mu, lo.min(hi)), px(e.mu, lo.max(hi)));
+                let style = BAND.stroke_width(3);
+                canvas.draw(&PathElement::new(vec![a, b], style))?;
+                canvas.draw(&PathElement::new(
+                    vec![(a.0 - 7, a.1), (a.0 + 7, a.1)],
+                    style,
+                ))?;
+                canvas.draw(&PathElement::new(
+                    vec![(b.0 - 7, b.1), (b.0 + 7, b.1)],
+                    style,
+                ))?;
+                if r.non_monotone {
+                    any_nonmono = true;
+                    let (x, y) = ((a.0 + b.0) / 2 + 14, (a.1 + b.1) / 2);
+                    canvas.draw(&Polygon::new(
+                        vec![(x, y - 7), (x + 7, y), (x, y + 7), (x - 7, y)],
+                        RGBColor(60, 60, 60).filled(),
+                    ))?;
+                }
+                continue;
+            }
+            let scanned = bounds(r.scanned.iter().map(|s| s.0).collect()).or(grid_speed);
+            let (Some(side), Some((s_lo, s_hi))) = (no_transition_side(r), scanned) else {
+                continue;
+            };
+            any_arrow = true;
+            let colour = RGBColor(60, 60, 60);
+            let style = chart_text_style(13.0).color(&colour);
+            if side {
+                let p = px(e.mu, s_hi);
+                arrow(&canvas, p, true, colour)?;
+                let text = format!("no whirl up to {} r/min", chart_quantity(s_hi));
+                canvas.draw_text(
+                    &text,
+                    &style.pos(Pos::new(HPos::Center, VPos::Bottom)),
+                    (p.0, p.1 - 24),
+                )?;
+            } else {
+                let p = px(e.mu, s_lo);
+                arrow(&canvas, p, false, colour)?;
+                let text = format!("whirl from {} r/min", chart_quantity(s_lo));
+                canvas.draw_text(
+                    &text,
+                    &style.pos(Pos::new(HPos::Center, VPos::Top)),
+                    (p.0, p.1 + 24),
+                )?;
+            }
+        }
+
+        // Region labels.
+        let (w, h) = canvas.dim_in_pixel();
+        let (w, h) = (w as i32, h as i32);
+        boxed_text(
+            &canvas,
+            "backward whirl",
+            (w / 2, (h as f64 * 0.04) as i32 + 8),
+            CHART_CAPTION_FONT,
+            class_colour(OrbitClass::BackwardWhirl),
+        )?;
+        boxed_text(
+            &canvas,
+            "pendulum vibration",
+            (w / 2, h - (h as f64 * 0.04) as i32 - 8),
+            CHART_CAPTION_FONT,
+            class_colour(OrbitClass::Pendulum),
+        )?;
+
+        let mut legend_entries = vec![(Mark::Band, "critical-speed bracket".to_string())];
+        for c in ALL_CLASSES.iter().filter(|c| classes_seen.contains(c)) {
+            legend_entries.push((Mark::Dot(class_colour(*c)), c.label().to_string()));
+        }
+        if any_failed {
+            legend_entries.push((Mark::Failed, "failed".to_string()));
+        }
+        if any_arrow {
+            legend_entries.push((Mark::Arrow, "no transition in range".to_string()));
+        }
+        if any_nonmono {
+            legend_entries.push((Mark::Diamond, "non-monotone scan".to_string()));
+        }
+        legend(&legend_band, &legend_entries)
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fig. 3: orbit panels.
+
+/// One recorded orbit from `orbits/*.json`.
+#[derive(Debug, Clone, Deserialize)]
+pub struct OrbitFile {
+    /// Release speed (r/min).
+    pub speed_rpm: f64,
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Orbit class (a class name).
+    #[serde(default)]
+    pub class: Value,
+    /// The recorded orbit.
+    pub orbit: Orbit,
+}
+
+impl OrbitFile {
+    fn class_label(&self) -> String {
+        match serde_json::from_value::<OrbitClass>(self.class.clone()) {
+            Ok(c) => c.label().to_string(),
+            Err(_) => match &self.class {
+                Value::String(s) => s.replace('_', " "),
+                Value::Null => "class unknown".to_string(),
+                other => other.to_string(),
+            },
+        }
+    }
+}
+
+/// Reads every `dir/orbits/*.json`, sorted by speed then friction; empty if there are none.
+pub fn load_orbits(dir: &Path) -> Result<Vec<OrbitFile>, ChartError> {
+    let odir = dir.join("orbits");
+    let Ok(read) = std::fs::read_dir(&odir) else {
+        return Ok(Vec::new());
+    };
+    let mut paths: Vec<PathBuf> = read
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        })
+        .collect();
+    paths.sort();
+    let mut out = Vec::new();
+    for path in paths {
+        let text = std::fs::read_to_string(&path).map_err(|cause| ChartError::Read {
+            path: path.clone(),
+            cause,
+        })?;
+        let o: OrbitFile = serde_json::from_str(&text).map_err(|e| ChartError::Parse {
+            path: path.clone(),
+            line: e.line(),
+            message: e.to_string(),
+        })?;
+        out.push(o);
+    }
+    out.sort_by(|a, b| {
+        a.speed_rpm
+            .total_cmp(&b.speed_rpm)
+            .then(a.mu.total_cmp(&b.mu))
+    });
+    Ok(out)
+}
+
+struct OrbitPanels<'a> {
+    orbits: &'a [OrbitFile],
+    title: String,
+}
+
+const START_COLOUR: RGBColor = RGBColor(44, 160, 44);
+const END_COLOUR: RGBColor = RGBColor(214, 39, 40);
+
+fn panel_layout(n: usize) -> (usize, usize) {
+    let cols = match n {
+        0 | 1 => 1,
+        2 | 4 => 2,
+        3 | 5 | 6 | 9 => 3,
+        _ => 4,
+    };
+    (cols, n.max(1).div_ceil(cols))
+}
+
+fn orbit_figure_size(n: usize) -> (u32, u32) {
+    let (cols, rows) = panel_layout(n);
+    let w = (cols as u32 * 420).max(1000);
+    let h = CHART_TITLE_BAND + 44 + rows as u32 * if cols == 1 { 600 } else { 430 };
+    (w, h.max(700))
+}
+
+impl Figure for OrbitPanels<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let body = chart_header(root, CHART_TITLE_BAND, &self.title, CHART_TITLE_FONT)?;
+        let (_, bh) = body.dim_in_pixel();
+        let (panels_area, legend_band) = body.split_vertically(bh.saturating_sub(44));
+        let (cols, rows) = panel_layout(self.orbits.len());
+        let panels = panels_area.split_evenly((rows, cols));
+        for (o, area) in self.orbits.iter().zip(panels.iter()) {
+            let caption = format!(
+                "µ = {}, {} r/min: {}",
+                chart_quantity(o.mu),
+                chart_quantity(o.speed_rpm),
+                o.class_label()
+            );
+            let plot = chart_header(area, 34, &caption, CHART_CAPTION_FONT)?;
+            let samples = decimate_samples(&o.orbit.samples, 8_000);
+            let path: Vec<(f64, f64)> = samples
+                .iter()
+                .map(|s| (s.x_rel_m * 1e6, s.y_rel_m * 1e6))
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect();
+            let clearance = Some(o.orbit.clearance_m * 1e6).filter(|c| c.is_finite() && *c > 0.0);
+            let extent = path
+                .iter()
+                .map(|(x, y)| x.abs().max(y.abs()))
+                .chain(clearance)
+                .fold(0.0_f64, f64::max);
+            let half = if extent > 0.0 && extent.is_finite() {
+                extent * 1.08
+            } else {
+                1.0
+            };
+
+            // A square plotting area, centred, for an equal aspect.
+            let (w, h) = plot.dim_in_pixel();
+            let (x_lab, y_lab) = (50_u32, 70_u32);
+            let side = h
+                .saturating_sub(8 + 6 + x_lab)
+                .min(w.saturating_sub(y_lab + 20))
+                .max(1);
+            let spare = w.saturating_sub(side + y_lab);
+            let margin_left = spare / 2;
+            let mut chart = ChartBuilder::on(&plot)
+                .margin_top(8)
+                .margin_bottom(h.saturating_sub(8 + side + x_lab))
+                .margin_left(margin_left)
+                .margin_right(spare - margin_left)
+                .x_label_area_size(x_lab)
+                .y_label_area_size(y_lab)
+                .build_cartesian_2d(-half..half, -half..half)?;
+            chart_mesh(&mut chart, "x (µm)", "y (µm)", 7, 7)?;
+            if let Some(c) = clearance {
+                let circle = (0..=360).map(|k| {
+                    let a = (k as f64).to_radians();
+                    (c * a.cos(), c * a.sin())
+                });
+                chart.draw_series(DashedLineSeries::new(
+                    circle,
+                    8,
+                    5,
+                    CHART_CLEARANCE_COLOUR.stroke_width(2),
+                ))?;
+            }
+            chart.draw_series(LineSeries::new(
+                path.iter().copied(),
+                CHART_PATH_COLOUR.stroke_width(1),
+            ))?;
+            if let (Some(&a), Some(&b)) = (path.first(), path.last()) {
+                chart.draw_series([
+                    Circle::new(a, 5, START_COLOUR.filled()),
+                    Circle::new(b, 5, END_COLOUR.filled()),
+                ])?;
+            }
+        }
+        legend(
+            &legend_band,
+            &[
+                (
+                    Mark::Line(CHART_PATH_COLOUR),
+                    "rotor-centre path relative to the race".to_string(),
+                ),
+                (
+                    Mark::Dashed(CHART_CLEARANCE_COLOUR),
+                    "clearance circle".to_string(),
+                ),
+                (Mark::Dot(START_COLOUR), "release".to_string()),
+                (Mark::Dot(END_COLOUR), "end".to_string()),
+            ],
+        )
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Entry point.
+
+fn write_both<F: Figure>(
+    out_dir: &Path,
+    stem: &str,
+    size: (u32, u32),
+    figure: &F,
+    written: &mut Vec<PathBuf>,
+) -> Result<(), ChartError> {
+    for ext in ["png", "svg"] {
+        let path = out_dir.join(format!("{stem}.{ext}"));
+        render(&path, size, figure)?;
+        written.push(path);
+    }
+    Ok(())
+}
+
+/// Draws every chart whose data exists in the results directory `dir` into `dir/charts/`, as
+/// PNG and SVG: `fig5_max_force`, `fig6_peak_power` and `classes` from `points.jsonl`
+/// (required), `fig4_critical` if `critical.json` exists, `fig3_orbits` if `orbits/` holds
+/// orbit files. Returns the paths written, in that order.
+pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
+    let rows = load_points(dir)?;
+    let critical = load_critical(dir)?;
+    let orbits = load_orbits(dir)?;
+    let grid = assemble_grid(&rows);
+
+    let out_dir = dir.join("charts");
+    std::fs::create_dir_all(&out_dir).map_err(|cause| ChartError::Write {
+        path: out_dir.clone(),
+        cause,
+    })?;
+    let mut written = Vec::new();
+    let fig5 = GridFigure {
+        grid: &grid,
+        title: with_slice("Fig. 5: maximum contact force", &grid.slice),
+        mode: GridMode::Metric(|r| r.max_contact_force_n),
+        bar_label: "max contact force (N)",
+    };
+    write_both(&out_dir, "fig5_max_force", CHART_SIZE, &fig5, &mut written)?;
+    let fig6 = GridFigure {
+        grid: &grid,
+        title: with_slice("Fig. 6: peak heat power", &grid.slice),
+        mode: GridMode::Metric(|r| r.peak_heat_power_w),
+        bar_label: "peak heat power (W)",
+    };
+    write_both(&out_dir, "fig6_peak_power", CHART_SIZE, &fig6, &mut written)?;
+    let classes = GridFigure {
+        grid: &grid,
+        title: with_slice("Orbit class over release speed and friction", &grid.slice),
+        mode: GridMode::Classes,
+        bar_label: "",
+    };
+    write_both(&out_dir, "classes", CHART_SIZE, &classes, &mut written)?;
+    if let Some(entries) = &critical {
+        let fig4 = CriticalFigure {
+            entries,
+            grid: &grid,
+            title: with_slice("Fig. 4: critical speed of backward whirl", &grid.slice),
+        };
+        write_both(&out_dir, "fig4_critical", CHART_SIZE, &fig4, &mut written)?;
+    }
+    if !orbits.is_empty() {
+        let speeds = distinct_sorted(orbits.iter().map(|o| o.speed_rpm));
+        let title = match speeds.as_slice() {
+            [s] => format!(
+                "Fig. 3: orbits relative to the race at {} r/min",
+                chart_quantity(*s)
+            ),
+            _ => "Fig. 3: orbits relative to the race".to_string(),
+        };
+        let fig3 = OrbitPanels {
+            orbits: &orbits,
+            title,
+        };
+        write_both(
+            &out_dir,
+            "fig3_orbits",
+            orbit_figure_size(orbits.len()),
+            &fig3,
+            &mut written,
+        )?;
+    }
+    Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn marching_squares_rings_a_cone() {
+        let n = 41;
+        let xs: Vec<f64> = (0..n)
+            .map(|i| -2.0 + 4.0 * i as f64 / (n - 1) as f64)
+            .collect();
+        let ys = xs.clone();
+        let z: Vec<f64> = (0..n * n)
+            .map(|k| {
+                let (x, y) = (xs[k % n], ys[k / n]);
+                (x * x + y * y).sqrt()
+            })
+            .collect();
+        // Levels off the grid nodes' radii (a node exactly on a level is a degenerate touch).
+        for r in [0.55, 1.05, 1.45] {
+            let segs = marching_squares(&xs, &ys, &z, r);
+            assert!(segs.len() > 8, "{r}: {}", segs.len());
+            // Every point lies near the circle of radius r.
+            for s in &segs {
+                for p in s {
+                    let d = (p.0 * p.0 + p.1 * p.1).sqrt();
+                    assert!((d - r).abs() < 0.01, "level {r}: point at {d}");
+                }
+            }
+            // Closed: every endpoint is shared by exactly two segments.
+            let ends: Vec<(f64, f64)> = segs.iter().flat_map(|s| [s[0], s[1]]).collect();
+            for p in &ends {
+                let k = ends
+                    .iter()
+                    .filter(|q| (q.0 - p.0).abs() < 1e-12 && (q.1 - p.1).abs() < 1e-12)
+                    .count();
+                assert_eq!(k, 2, "level {r}: open end at {p:?}");
+            }
+            // And it goes all the way round.
+            let mut quadrants = [false; 4];
+            for p in &ends {
+                quadrants[(p.0 >= 0.0) as usize * 2 + (p.1 >= 0.0) as usize] = true;
+            }
+            assert!(quadrants.iter().all(|q| *q));
+        }
+        // NaN cells are skipped; a level outside the data gives nothing.
+        let mut z2 = z.clone();
+        z2.iter_mut().for_each(|v| *v = f64::NAN);
+        assert!(marching_squares(&xs, &ys, &z2, 1.0).is_empty());
+        assert!(marching_squares(&xs, &ys, &z, 10.0).is_empty());
+    }
+
+    #[test]
+    fn marching_squares_saddle_gives_two_segments() {
+        let xs = [0.0, 1.0];
+        let ys = [0.0, 1.0];
+        let z = [1.0, 0.0, 0.0, 1.0]; // a, b / d, c: diagonal highs
+        assert_eq!(marching_squares(&xs, &ys, &z, 0.5).len(), 2);
+    }
+
+    #[test]
+    fn levels_are_round_and_inside() {
+        assert_eq!(nice_levels(0.0, 10.0, 5), vec![2.0, 4.0, 6.0, 8.0]);
+        let l = nice_levels(123.0, 987.0, 6);
+        assert!(
+            l.iter().all(|v| *v > 123.0 && *v < 987.0) && l.len() >= 4,
+            "{l:?}"
+        );
+        assert!(nice_levels(1.0, 1.0, 5).is_empty());
+    }
+
+    #[test]
+    fn grid_takes_first_slice_of_a_third_axis() {
+        let row = |i: u64, s: f64, m: f64, c: f64| PointRow {
+            key: format!("k{i}"),
+            index: Some(i),
+            inputs: [
+                ("speed_rpm".to_string(), Value::from(s)),
+                ("mu".to_string(), Value::from(m)),
+                ("clearance_m".to_string(), Value::from(c)),
+            ]
+            .into_iter()
+            .collect(),
+            status: PointStatus::Failed,
+            class: None,
+            max_contact_force_n: None,
+            peak_heat_power_w: None,
+            error: None,
+        };
+        let rows = vec![
+            row(3, 1000.0, 0.1, 2e-4),
+            row(0, 1000.0, 0.1, 1e-4),
+            row(1, 2000.0, 0.1, 1e-4),
+            row(2, 2000.0, 0.2, 1e-4),
+        ];
+        let g = assemble_grid(&rows);
+        assert_eq!(g.speeds_rpm, vec![1000.0, 2000.0]);
+        assert_eq!(g.mus, vec![0.1, 0.2]);
+        assert_eq!(g.rows.len(), 3);
+        assert!(g.cell(0, 1).is_none());
+        assert_eq!(g.cell(1, 1).unwrap().key, "k2");
+        assert_eq!(g.slice.as_deref(), Some("slice at clearance_m = 0.0001"));
+    }
+}

@@ -1,0 +1,791 @@
+//! Sweep specification: a JSON file naming a grid of drops over scene parameters.
+//!
+//! ```json
+//! {"name": "paper", "scene": {"clearance_m": 1.5e-4}, "duration_s": 1.0,
+//!  "axes": {"speed_rpm": {"from": 2000, "to": 10000, "steps": 5}, "mu": [0.1, 0.2, 0.3]},
+//!  "critical": {"mu": [0.1, 0.3], "speed_rpm": {"from": 1000, "to": 20000}, "tol_rpm": 50},
+//!  "charts": ["orbits", "critical", "max_force", "peak_power", "classes"]}
+//! ```
+//!
+//! - `scene`: any subset of the scene's fields (as printed by `whirlmap scene`); the rest
+//!   take the paper's defaults. Unknown keys are rejected.
+//! - `axes`: axis name -> a list of values, or `{"from", "to", "steps"}` with `steps` points
+//!   including both ends (`steps: 1` is just `from`). `mu` means `mu_dynamic`; any other name
+//!   is a scene parameter set by [`crate::overrides::apply`] (dotted for nested fields, e.g.
+//!   `solver.max_step_attempts`). Axes keep the order written in the file; the grid is
+//!   row-major: the first axis varies slowest, the last fastest.
+//! - `critical` (optional): the critical-speed search ([`CriticalSpec`]).
+//! - `charts` (optional): chart names out of [`CHART_NAMES`].
+//!
+//! Everything is checked by [`load`] before any drop runs; every error names the field and
+//! the value. Parse errors carry the file path, line and column.
+
+use crate::overrides::{self, OverrideError};
+use serde::de::{self, Deserializer, MapAccess, Visitor};
+use serde::ser::{SerializeMap, Serializer};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+use whirlmap_core::{InvalidParameter, Scene};
+
+/// Chart names a spec may list.
+pub const CHART_NAMES: &[&str] = &["orbits", "critical", "max_force", "peak_power", "classes"];
+
+/// Largest grid a spec may describe.
+pub const MAX_POINTS: usize = 10_000_000;
+
+/// Why a sweep spec is unusable. Every variant names the field and the value.
+#[derive(Debug, Error)]
+pub enum SpecError {
+    /// The file could not be read.
+    #[error("cannot read sweep spec {path}: {source}")]
+    Read {
+        /// The spec file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// Not valid JSON, an unknown key or a wrong type (serde's message has line and column).
+    #[error("sweep spec {path}: {source}")]
+    Parse {
+        /// The spec file.
+        path: PathBuf,
+        /// serde_json's error.
+        source: serde_json::Error,
+    },
+    /// The spec has no axes.
+    #[error("axes: at least one axis is required")]
+    NoAxes,
+    /// An axis given as an empty list.
+    #[error("axes.{axis}: empty list of values")]
+    EmptyAxis {
+        /// Axis name.
+        axis: String,
+    },
+    /// An axis range with `steps: 0`.
+    #[error("axes.{axis}.steps = 0: need at least 1 point")]
+    ZeroSteps {
+        /// Axis name.
+        axis: String,
+    },
+    /// A range with `from > to`.
+    #[error("{field}: from = {from} is greater than to = {to}")]
+    ReversedRange {
+        /// The range's field (`axes.speed_rpm`, `critical.speed_rpm`).
+        field: String,
+        /// Lower end as given.
+        from: f64,
+        /// Upper end as given.
+        to: f64,
+    },
+    /// The same scene parameter named by two axes.
+    #[error("axes.{axis}: sets the same scene parameter as another axis")]
+    DuplicateAxis {
+        /// Axis name.
+        axis: String,
+    },
+    /// An axis that is not a scene parameter, or a value of the wrong type for it.
+    #[error("axes.{axis}: {source}")]
+    Axis {
+        /// Axis name.
+        axis: String,
+        /// The override error (names the key and lists the known ones).
+        source: OverrideError,
+    },
+    /// A friction coefficient outside [0, 2].
+    #[error("{field} = {value}: friction coefficient must be in [0, 2]")]
+    MuOutOfRange {
+        /// `axes.mu` or `critical.mu`.
+        field: String,
+        /// The value.
+        value: f64,
+    },
+    /// `duration_s` not in (0, 3600].
+    #[error("duration_s = {value}: must be > 0 and at most 3600 s")]
+    Duration {
+        /// The value.
+        value: f64,
+    },
+    /// A chart name not in [`CHART_NAMES`].
+    #[error("charts: unknown chart `{name}`; known: {known}")]
+    UnknownChart {
+        /// The name as given.
+        name: String,
+        /// The known names, comma-separated.
+        known: String,
+    },
+    /// Any other field out of its allowed range.
+    #[error("{field} = {value}: allowed {allowed}")]
+    Invalid {
+        /// The field (dotted path in the spec).
+        field: String,
+        /// The value as text.
+        value: String,
+        /// The allowed range in words.
+        allowed: String,
+    },
+    /// A grid point whose scene fails validation.
+    #[error("grid point {index} ({inputs}): {source}")]
+    InvalidScene {
+        /// Grid index.
+        index: usize,
+        /// The point's axis values, `name=value, ...`.
+        inputs: String,
+        /// Which scene field, its value and its range.
+        source: InvalidParameter,
+    },
+    /// The output folder cannot be created or written.
+    #[error("output folder {path} is not writable: {source}")]
+    Output {
+        /// The folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+}
+
+/// A closed interval (the critical-speed search range).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangeSpec {
+    /// Lower end.
+    pub from: f64,
+    /// Upper end (>= from).
+    pub to: f64,
+}
+
+fn default_tol_rpm() -> f64 {
+    50.0
+}
+
+/// The critical-speed search: for each `mu`, the speed in `speed_rpm` where the orbit
+/// turns into whirl, located to within `tol_rpm`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CriticalSpec {
+    /// Friction coefficients (each in [0, 2], at least one).
+    pub mu: Vec<f64>,
+    /// Speed bracket (r/min).
+    pub speed_rpm: RangeSpec,
+    /// Tolerance on the critical speed (r/min), > 0. Default 50.
+    #[serde(default = "default_tol_rpm")]
+    pub tol_rpm: f64,
+}
+
+/// The values of one axis: a list, or `steps` evenly spaced points from `from` to `to`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AxisValues {
+    /// Explicit values, in order.
+    List(Vec<f64>),
+    /// `steps` points including both ends.
+    Range {
+        /// First value.
+        from: f64,
+        /// Last value (>= from).
+        to: f64,
+        /// Number of points (>= 1; 1 means just `from`).
+        steps: usize,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RangeSteps {
+    from: f64,
+    to: f64,
+    steps: usize,
+}
+
+impl AxisValues {
+    /// The axis's values in order (not validated).
+    pub fn values(&self) -> Vec<f64> {
+        match self {
+            AxisValues::List(v) => v.clone(),
+            AxisValues::Range { from, to, steps } => match *steps {
+                0 => Vec::new(),
+                1 => vec![*from],
+                n => (0..n)
+                    .map(|i| {
+                        if i + 1 == n {
+                            *to
+                        } else {
+                            from + (to - from) * (i as f64) / ((n - 1) as f64)
+                        }
+                    })
+                    .collect(),
+            },
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for AxisValues {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        match Value::deserialize(d)? {
+            v @ Value::Array(_) => serde_json::from_value::<Vec<f64>>(v)
+                .map(AxisValues::List)
+                .map_err(|e| de::Error::custom(format!("axis values: {e}"))),
+            v @ Value::Object(_) => serde_json::from_value::<RangeSteps>(v)
+                .map(|r| AxisValues::Range {
+                    from: r.from,
+                    to: r.to,
+                    steps: r.steps,
+                })
+                .map_err(|e| de::Error::custom(format!("axis range: {e}"))),
+            other => Err(de::Error::custom(format!(
+                "axis values must be a list of numbers or {{\"from\", \"to\", \"steps\"}}, got {other}"
+            ))),
+        }
+    }
+}
+
+impl Serialize for AxisValues {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            AxisValues::List(v) => v.serialize(s),
+            AxisValues::Range { from, to, steps } => {
+                let mut m = s.serialize_map(Some(3))?;
+                m.serialize_entry("from", from)?;
+                m.serialize_entry("to", to)?;
+                m.serialize_entry("steps", steps)?;
+                m.end()
+            }
+        }
+    }
+}
+
+/// One axis: its name as written and its values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// `mu` or a scene parameter name.
+    pub name: String,
+    /// The values.
+    pub values: AxisValues,
+}
+
+impl Axis {
+    /// The scene key this axis sets (`mu` -> `mu_dynamic`).
+    pub fn scene_key(&self) -> &str {
+        if self.name == "mu" {
+            "mu_dynamic"
+        } else {
+            &self.name
+        }
+    }
+}
+
+/// The axes in the order written in the file (a JSON object read entry by entry, so the
+/// order does not depend on serde_json's map type). Serialises back as an object in order.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Axes(pub Vec<Axis>);
+
+impl<'de> Deserialize<'de> for Axes {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Axes;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("an object of axis name -> values")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Axes, A::Error> {
+                let mut axes: Vec<Axis> = Vec::new();
+                while let Some(name) = map.next_key::<String>()? {
+                    if axes.iter().any(|a| a.name == name) {
+                        return Err(de::Error::custom(format!("duplicate axis `{name}`")));
+                    }
+                    let values = map.next_value::<AxisValues>()?;
+                    axes.push(Axis { name, values });
+                }
+                Ok(Axes(axes))
+            }
+        }
+        d.deserialize_map(V)
+    }
+}
+
+impl Serialize for Axes {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(self.0.len()))?;
+        for a in &self.0 {
+            m.serialize_entry(&a.name, &a.values)?;
+        }
+        m.end()
+    }
+}
+
+/// A parsed sweep spec.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSpec {
+    /// Sweep name: the default output folder is `results/<name>`. Letters, digits, `_`,
+    /// `-` and `.` only.
+    pub name: String,
+    /// The base scene: the paper's with the file's overrides.
+    #[serde(default)]
+    pub scene: Scene,
+    /// Simulated time of every drop (s), (0, 3600].
+    pub duration_s: f64,
+    /// The grid axes, in file order.
+    pub axes: Axes,
+    /// The critical-speed search, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub critical: Option<CriticalSpec>,
+    /// Charts to draw after the sweep.
+    #[serde(default)]
+    pub charts: Vec<String>,
+    /// Orbits recorded for the Fig. 3 chart (`orbits` in `charts`); default: 8000 r/min and
+    /// the values of the `mu` axis (at most eight).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orbits: Option<OrbitsSpec>,
+}
+
+/// The Fig. 3 panels: one drop per friction coefficient at one speed, orbit recorded.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrbitsSpec {
+    /// Release speed of every panel (r/min).
+    pub speed_rpm: f64,
+    /// One panel per friction coefficient, each in [0, 2].
+    pub mu: Vec<f64>,
+}
+
+/// One grid point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// Row-major index in the grid (first axis slowest).
+    pub index: usize,
+    /// Axis name -> value, in the spec's axis order.
+    pub inputs: Vec<(String, f64)>,
+    /// The full scene of this point.
+    pub scene: Scene,
+}
+
+impl Point {
+    /// `name=value, ...` for messages.
+    pub fn inputs_text(&self) -> String {
+        inputs_text(&self.inputs)
+    }
+}
+
+fn inputs_text(inputs: &[(String, f64)]) -> String {
+    inputs
+        .iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A JSON value for an axis value: integral values become JSON integers so integer scene
+/// fields (`solver.max_step_attempts`) accept them; float fields accept both.
+fn axis_json(v: f64) -> Value {
+    if v.fract() == 0.0 && v.abs() < 9.0e15 {
+        Value::from(v as i64)
+    } else {
+        Value::from(v)
+    }
+}
+
+fn check_mu(field: &str, v: f64) -> Result<(), SpecError> {
+    if (0.0..=2.0).contains(&v) {
+        Ok(())
+    } else {
+        Err(SpecError::MuOutOfRange {
+            field: field.to_string(),
+            value: v,
+        })
+    }
+}
+
+fn check_range(field: &str, from: f64, to: f64) -> Result<(), SpecError> {
+    if from > to {
+        Err(SpecError::ReversedRange {
+            field: field.to_string(),
+            from,
+            to,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+/// Reads, parses and validates a spec (every grid point's scene included).
+pub fn load(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|source| SpecError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let spec = parse(&text).map_err(|source| SpecError::Parse {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    spec.validate()?;
+    spec.points()?;
+    Ok(spec)
+}
+
+/// Parses spec text (no validation beyond types and unknown keys).
+pub fn parse(text: &str) -> Result<SweepSpec, serde_json::Error> {
+    serde_json::from_str(text)
+}
+
+impl SweepSpec {
+    /// Checks everything but the grid points' scenes (see [`SweepSpec::points`]).
+    pub fn validate(&self) -> Result<(), SpecError> {
+        let name_ok = !self.name.is_empty()
+            && self.name != "."
+            && self.name != ".."
+            && self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'));
+        if !name_ok {
+            return Err(SpecError::Invalid {
+                field: "name".into(),
+                value: format!("{:?}", self.name),
+                allowed: "a non-empty folder name of letters, digits, '_', '-', '.'".into(),
+            });
+        }
+        if !(self.duration_s > 0.0 && self.duration_s <= 3600.0) {
+            return Err(SpecError::Duration {
+                value: self.duration_s,
+            });
+        }
+        if self.axes.0.is_empty() {
+            return Err(SpecError::NoAxes);
+        }
+        let mut keys: Vec<&str> = Vec::new();
+        let mut total: usize = 1;
+        for axis in &self.axes.0 {
+            let field = format!("axes.{}", axis.name);
+            match &axis.values {
+                AxisValues::List(v) if v.is_empty() => {
+                    return Err(SpecError::EmptyAxis {
+                        axis: axis.name.clone(),
+                    })
+                }
+                AxisValues::Range { steps: 0, .. } => {
+                    return Err(SpecError::ZeroSteps {
+                        axis: axis.name.clone(),
+                    })
+                }
+                AxisValues::Range { from, to, .. } => check_range(&field, *from, *to)?,
+                AxisValues::List(_) => {}
+            }
+            let key = axis.scene_key();
+            if keys.contains(&key) {
+                return Err(SpecError::DuplicateAxis {
+                    axis: axis.name.clone(),
+                });
+            }
+            keys.push(key);
+            let values = axis.values.values();
+            if key == "mu_dynamic" {
+                for v in &values {
+                    check_mu(&field, *v)?;
+                }
+            }
+            // Unknown names and values of the wrong type, checked on the base scene.
+            for v in &values {
+                let mut s = self.scene.clone();
+                overrides::apply(&mut s, key, axis_json(*v)).map_err(|source| SpecError::Axis {
+                    axis: axis.name.clone(),
+                    source,
+                })?;
+            }
+            total = total.saturating_mul(values.len());
+        }
+        if total > MAX_POINTS {
+            return Err(SpecError::Invalid {
+                field: "axes".into(),
+                value: format!("{total} grid points"),
+                allowed: format!("at most {MAX_POINTS} points"),
+            });
+        }
+        if let Some(c) = &self.critical {
+            if c.mu.is_empty() {
+                return Err(SpecError::Invalid {
+                    field: "critical.mu".into(),
+                    value: "[]".into(),
+                    allowed: "at least one value".into(),
+                });
+            }
+            for v in &c.mu {
+                check_mu("critical.mu", *v)?;
+            }
+            check_range("critical.speed_rpm", c.speed_rpm.from, c.speed_rpm.to)?;
+            if !(c.tol_rpm > 0.0 && c.tol_rpm.is_finite()) {
+                return Err(SpecError::Invalid {
+                    field: "critical.tol_rpm".into(),
+                    value: c.tol_rpm.to_string(),
+                    allowed: "> 0 r/min".into(),
+                });
+            }
+        }
+        if let Some(o) = &self.orbits {
+            if o.mu.is_empty() {
+                return Err(SpecError::Invalid {
+                    field: "orbits.mu".into(),
+                    value: "[]".into(),
+                    allowed: "at least one value".into(),
+                });
+            }
+            for v in &o.mu {
+                check_mu("orbits.mu", *v)?;
+            }
+            if !(o.speed_rpm.is_finite() && o.speed_rpm.abs() <= 1e6) {
+                return Err(SpecError::Invalid {
+                    field: "orbits.speed_rpm".into(),
+                    value: o.speed_rpm.to_string(),
+                    allowed: "[-1e6, 1e6] r/min".into(),
+                });
+            }
+        }
+        for c in &self.charts {
+            if !CHART_NAMES.contains(&c.as_str()) {
+                return Err(SpecError::UnknownChart {
+                    name: c.clone(),
+                    known: CHART_NAMES.join(", "),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of grid points.
+    pub fn len(&self) -> usize {
+        self.axes
+            .0
+            .iter()
+            .map(|a| a.values.values().len())
+            .product()
+    }
+
+    /// Whether the grid is empty (only for an invalid spec).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Every grid point, row-major (first axis slowest), each scene validated.
+    pub fn points(&self) -> Result<Vec<Point>, SpecError> {
+        self.validate()?;
+        let axes: Vec<(&Axis, Vec<f64>)> =
+            self.axes.0.iter().map(|a| (a, a.values.values())).collect();
+        let total = self.len();
+        let mut points = Vec::with_capacity(total);
+        let mut idx = vec![0usize; axes.len()];
+        for index in 0..total {
+            let mut scene = self.scene.clone();
+            let mut inputs = Vec::with_capacity(axes.len());
+            for (k, (axis, values)) in axes.iter().enumerate() {
+                let v = values[idx[k]];
+                overrides::apply(&mut scene, axis.scene_key(), axis_json(v)).map_err(|source| {
+                    SpecError::Axis {
+                        axis: axis.name.clone(),
+                        source,
+                    }
+                })?;
+                inputs.push((axis.name.clone(), v));
+            }
+            scene.validate().map_err(|source| SpecError::InvalidScene {
+                index,
+                inputs: inputs_text(&inputs),
+                source,
+            })?;
+            points.push(Point {
+                index,
+                inputs,
+                scene,
+            });
+            // Odometer: last axis fastest.
+            for k in (0..axes.len()).rev() {
+                idx[k] += 1;
+                if idx[k] < axes[k].1.len() {
+                    break;
+                }
+                idx[k] = 0;
+            }
+        }
+        Ok(points)
+    }
+}
+
+/// Creates `dir` (and parents) and writes and removes a probe file, so an unwritable output
+/// folder is reported before any drop runs.
+pub fn check_output_dir(dir: &Path) -> Result<(), SpecError> {
+    let err = |source| SpecError::Output {
+        path: dir.to_path_buf(),
+        source,
+    };
+    std::fs::create_dir_all(dir).map_err(err)?;
+    let probe = dir.join(format!(".whirlmap-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"probe").map_err(err)?;
+    std::fs::remove_file(&probe).map_err(err)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"{
+        "name": "t",
+        "scene": {"clearance_m": 2e-4, "solver": {"rtol": 1e-6}},
+        "duration_s": 0.05,
+        "axes": {"speed_rpm": {"from": 1000, "to": 3000, "steps": 3}, "mu": [0.1, 0.3]},
+        "critical": {"mu": [0.1], "speed_rpm": {"from": 1000, "to": 9000}},
+        "charts": ["orbits", "classes"]
+    }"#;
+
+    fn with(f: impl FnOnce(&mut Value)) -> Result<SweepSpec, String> {
+        let mut v: Value = serde_json::from_str(GOOD).unwrap();
+        f(&mut v);
+        let spec = parse(&v.to_string()).map_err(|e| e.to_string())?;
+        spec.validate().map_err(|e| e.to_string())?;
+        spec.points().map_err(|e| e.to_string())?;
+        Ok(spec)
+    }
+
+    fn err(f: impl FnOnce(&mut Value)) -> String {
+        with(f).expect_err("should be rejected")
+    }
+
+    #[test]
+    fn parses_and_builds_a_row_major_grid_in_file_order() {
+        let spec = parse(GOOD).unwrap();
+        spec.validate().unwrap();
+        assert_eq!(spec.scene.clearance_m, 2e-4);
+        assert_eq!(spec.scene.solver.rtol, 1e-6);
+        assert_eq!(spec.scene.mu_dynamic, 0.1, "unset fields keep the default");
+        let c = spec.critical.as_ref().unwrap();
+        assert_eq!(c.tol_rpm, 50.0);
+        assert_eq!(
+            c.speed_rpm,
+            RangeSpec {
+                from: 1000.0,
+                to: 9000.0
+            }
+        );
+        let names: Vec<_> = spec.axes.0.iter().map(|a| a.name.as_str()).collect();
+        assert_eq!(names, ["speed_rpm", "mu"], "file order, not sorted");
+        let p = spec.points().unwrap();
+        assert_eq!(p.len(), 6);
+        assert_eq!(p[1].index, 1);
+        assert_eq!(
+            p[1].inputs,
+            vec![("speed_rpm".to_string(), 1000.0), ("mu".to_string(), 0.3)]
+        );
+        assert_eq!(p[1].scene.mu_dynamic, 0.3);
+        assert_eq!(p[5].scene.speed_rpm, 3000.0);
+        assert_eq!(p[2].scene.speed_rpm, 2000.0);
+        assert_eq!(p[2].scene.clearance_m, 2e-4);
+        // Serialises back with the axes in file order.
+        let text = serde_json::to_string(&spec).unwrap();
+        assert!(text.find("speed_rpm\":{").unwrap() < text.find("\"mu\":[").unwrap());
+        assert_eq!(parse(&text).unwrap(), spec);
+    }
+
+    #[test]
+    fn ranges_include_both_ends_and_one_step_is_from() {
+        let r = AxisValues::Range {
+            from: 0.0,
+            to: 1.0,
+            steps: 5,
+        };
+        assert_eq!(r.values(), vec![0.0, 0.25, 0.5, 0.75, 1.0]);
+        let r = AxisValues::Range {
+            from: 2.0,
+            to: 7.0,
+            steps: 1,
+        };
+        assert_eq!(r.values(), vec![2.0]);
+    }
+
+    #[test]
+    fn any_scene_parameter_can_be_an_axis_including_integers() {
+        let spec = with(|v| {
+            v["axes"] = serde_json::json!({"solver.max_step_attempts": [10, 1000], "unbalance_m": [0, 1e-5]});
+        })
+        .unwrap();
+        let p = spec.points().unwrap();
+        assert_eq!(p[0].scene.solver.max_step_attempts, 10);
+        assert_eq!(p[3].scene.unbalance_m, 1e-5);
+    }
+
+    #[test]
+    fn unknown_keys_and_type_errors_carry_line_and_column() {
+        let e = err(|v| v["colour"] = Value::from(1));
+        assert!(e.contains("colour") && e.contains("line"), "{e}");
+        let e = err(|v| v["scene"]["clearence_m"] = Value::from(1e-4));
+        assert!(e.contains("clearence_m") && e.contains("column"), "{e}");
+        let e = err(|v| v["duration_s"] = Value::from("long"));
+        assert!(e.contains("line"), "{e}");
+        let e = err(|v| v["axes"]["mu"] = serde_json::json!({"from": 0, "to": 1, "step": 2}));
+        assert!(e.contains("step") && e.contains("line"), "{e}");
+        let e = err(|v| v["critical"]["tolerance"] = Value::from(1));
+        assert!(e.contains("tolerance"), "{e}");
+    }
+
+    #[test]
+    fn each_validation_error_names_the_field_and_value() {
+        let e = err(|v| v["axes"]["mu"] = serde_json::json!([]));
+        assert!(e.contains("axes.mu") && e.contains("empty"), "{e}");
+        let e = err(|v| v["axes"]["mu"] = serde_json::json!({"from": 0, "to": 1, "steps": 0}));
+        assert!(e.contains("axes.mu.steps = 0"), "{e}");
+        let e = err(|v| {
+            v["axes"]["speed_rpm"] = serde_json::json!({"from": 5000, "to": 1000, "steps": 3})
+        });
+        assert!(e.contains("axes.speed_rpm") && e.contains("5000"), "{e}");
+        let e = err(|v| v["charts"] = serde_json::json!(["orbits", "pie"]));
+        assert!(e.contains("charts") && e.contains("pie"), "{e}");
+        let e = err(|v| v["axes"]["clearence_m"] = serde_json::json!([1e-4]));
+        assert!(
+            e.contains("axes.clearence_m") && e.contains("clearance_m"),
+            "{e}"
+        );
+        let e = err(|v| v["axes"]["mu"] = serde_json::json!([0.1, 2.5]));
+        assert!(e.contains("axes.mu = 2.5"), "{e}");
+        let e = err(|v| v["duration_s"] = Value::from(0.0));
+        assert!(e.contains("duration_s = 0"), "{e}");
+        let e = err(|v| v["duration_s"] = Value::from(-1.0));
+        assert!(e.contains("duration_s = -1"), "{e}");
+        let e = err(|v| v["axes"]["clearance_m"] = serde_json::json!([1e-4, -1e-3]));
+        assert!(
+            e.contains("grid point ") && e.contains("clearance_m = -0.001"),
+            "{e}"
+        );
+        let e = err(|v| v["axes"] = serde_json::json!({}));
+        assert!(e.contains("axes"), "{e}");
+        let e = err(|v| v["critical"]["mu"] = serde_json::json!([3.0]));
+        assert!(e.contains("critical.mu = 3"), "{e}");
+        let e = err(|v| v["critical"]["speed_rpm"] = serde_json::json!({"from": 9, "to": 1}));
+        assert!(e.contains("critical.speed_rpm"), "{e}");
+        let e = err(|v| v["critical"]["tol_rpm"] = Value::from(0));
+        assert!(e.contains("critical.tol_rpm = 0"), "{e}");
+        let e = err(|v| v["name"] = Value::from("../x"));
+        assert!(e.contains("name"), "{e}");
+        let e = err(|v| v["axes"]["mu_dynamic"] = serde_json::json!([0.2]));
+        assert!(e.contains("axes.mu_dynamic"), "{e}");
+    }
+
+    #[test]
+    fn load_names_the_file_and_an_unwritable_folder_is_reported() {
+        let dir = std::env::temp_dir().join(format!("whirlmap-spec-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("bad.json");
+        std::fs::write(&path, "{\"name\": \"x\",\n \"bogus\": 1}").unwrap();
+        let e = load(&path).unwrap_err().to_string();
+        assert!(e.contains("bad.json") && e.contains("line 2"), "{e}");
+        assert!(matches!(
+            load(dir.join("missing.json")),
+            Err(SpecError::Read { .. })
+        ));
+        let file = dir.join("a-file");
+        std::fs::write(&file, "x").unwrap();
+        let e = check_output_dir(&file.join("sub")).unwrap_err();
+        assert!(matches!(e, SpecError::Output { .. }), "{e}");
+        check_output_dir(&dir.join("out")).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,243 @@
+//! End-to-end test of the design charts on a synthetic results directory.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::json;
+use whirlmap_sweep::charts::{load_points, render_all, ChartError, PointStatus};
+
+const SPEEDS: [f64; 6] = [2000.0, 4000.0, 6000.0, 8000.0, 10000.0, 12000.0];
+const MUS: [f64; 5] = [0.05, 0.1, 0.15, 0.2, 0.3];
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("whirlmap-charts-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The class of a synthetic point: whirl above a critical speed falling with mu.
+fn class_of(speed: f64, mu: f64) -> &'static str {
+    if speed > 11000.0 - 30000.0 * mu {
+        if mu >= 0.3 && speed >= 12000.0 {
+            "forward_whirl"
+        } else {
+            "backward_whirl"
+        }
+    } else if mu <= 0.05 {
+        "bouncing"
+    } else if speed == 2000.0 && mu >= 0.2 {
+        "unresolved"
+    } else {
+        "pendulum"
+    }
+}
+
+/// Writes a 6 x 5 grid (whirl, one failed point, a torn last line), critical.json and one
+/// orbit file into `dir`.
+pub fn write_synthetic(dir: &Path, orbits: usize) {
+    let mut lines = Vec::new();
+    let mut index = 0;
+    for &mu in &MUS {
+        for &speed in &SPEEDS {
+            let inputs = json!({"speed_rpm": speed, "mu": mu});
+            let line = if speed == 6000.0 && mu == 0.1 {
+                json!({"key": format!("p{index}"), "index": index, "inputs": inputs,
+                       "scene_hash": "abc", "duration_s": 1.0, "model_version": 1,
+                       "status": "failed",
+                       "error": {"kind": "step_size_underflow", "message": "step size underflow"}})
+            } else {
+                let force = 400.0 + 0.06 * speed + 3000.0 * mu + 1e-6 * speed * speed * mu * 10.0;
+                let heat = 50.0 + 0.02 * speed * mu * 10.0 + 200.0 * mu;
+                json!({"key": format!("p{index}"), "index": index, "inputs": inputs,
+                       "scene_hash": "abc", "duration_s": 1.0, "model_version": 1,
+                       "status": "ok",
+                       "record": {"class": class_of(speed, mu),
+                                  "first_contact_force_n": force * 0.8,
+                                  "max_contact_force_n": force,
+                                  "peak_friction_power_w": heat * 0.9,
+                                  "peak_heat_power_w": heat,
+                                  "whirl_frequency_hz": 0.0}})
+            };
+            lines.push(line.to_string());
+            index += 1;
+        }
+    }
+    let mut text = lines.join("\n");
+    text.push_str("\n{\"key\": \"p99\", \"index\": 99, \"inputs\": {\"speed_r");
+    std::fs::write(dir.join("points.jsonl"), text).unwrap();
+
+    let mut critical = Vec::new();
+    for &mu in &MUS {
+        let crit = 11000.0 - 30000.0 * mu;
+        let result = if mu == 0.05 {
+            json!({"bracket": null, "class_lo": "bouncing", "class_hi": "bouncing",
+                   "drops_used": 4, "non_monotone": false,
+                   "scanned": [[2000.0, "bouncing"], [12000.0, "bouncing"]],
+                   "note": "no whirl in range"})
+        } else {
+            json!({"bracket": [crit - 400.0, crit + 300.0], "class_lo": "pendulum",
+                   "class_hi": "backward_whirl", "drops_used": 9, "non_monotone": mu == 0.2,
+                   "scanned": [[2000.0, "pendulum"], [12000.0, "backward_whirl"]], "note": null})
+        };
+        critical.push(json!({"mu": mu, "result": result}));
+    }
+    std::fs::write(
+        dir.join("critical.json"),
+        serde_json::to_string_pretty(&critical).unwrap(),
+    )
+    .unwrap();
+
+    let odir = dir.join("orbits");
+    std::fs::create_dir_all(&odir).unwrap();
+    let c = 2e-4;
+    for k in 0..orbits {
+        let mu = MUS[k % MUS.len()];
+        let whirl = k % 2 == 1;
+        let samples: Vec<_> = (0..2000)
+            .map(|i| {
+                let t = i as f64 * 1e-4;
+                let (x, y) = if whirl {
+                    let r = c * (1.0 - (-t * 20.0).exp()) * 0.98;
+                    let a = -std::f64::consts::FRAC_PI_2 - t * 60.0;
+                    (r * a.cos(), r * a.sin())
+                } else {
+                    let a =
+                        -std::f64::consts::FRAC_PI_2 + 0.4 * (t * 40.0).sin() * (-t * 3.0).exp();
+                    let r = c * (1.0 - (-t * 40.0).exp());
+                    (r * a.cos(), r * a.sin())
+                };
+                json!({"t_s": t, "x_rel_m": x, "y_rel_m": y, "contact_force_n": 100.0})
+            })
+            .collect();
+        let class = if whirl { "backward_whirl" } else { "pendulum" };
+        let file = json!({"speed_rpm": 8000.0, "mu": mu, "class": class,
+                          "orbit": {"clearance_m": c, "samples": samples}});
+        std::fs::write(odir.join(format!("orbit_{k}.json")), file.to_string()).unwrap();
+    }
+}
+
+#[test]
+fn torn_last_line_is_skipped() {
+    let dir = temp_dir("load");
+    write_synthetic(&dir, 0);
+    let rows = load_points(&dir).unwrap();
+    assert_eq!(rows.len(), 30);
+    assert_eq!(
+        rows.iter()
+            .filter(|r| r.status == PointStatus::Failed)
+            .count(),
+        1
+    );
+    // A torn line in the middle is an error.
+    let text = std::fs::read_to_string(dir.join("points.jsonl")).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines.swap(3, 30);
+    std::fs::write(dir.join("points.jsonl"), lines.join("\n")).unwrap();
+    assert!(matches!(
+        load_points(&dir),
+        Err(ChartError::Parse { line: 4, .. })
+    ));
+    let missing = temp_dir("missing");
+    assert!(matches!(
+        load_points(&missing),
+        Err(ChartError::NoPoints { .. })
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&missing);
+}
+
+#[test]
+fn render_all_writes_every_chart_as_png_and_svg() {
+    let dir = temp_dir("render");
+    write_synthetic(&dir, 1);
+    let written = render_all(&dir).unwrap();
+    let stems = [
+        (
+            "fig5_max_force",
+            vec![
+                "release speed (r/min)",
+                "friction coefficient",
+                "max contact force (N)",
+                "backward whirl (not in scale)",
+            ],
+        ),
+        (
+            "fig6_peak_power",
+            vec![
+                "release speed (r/min)",
+                "friction coefficient",
+                "peak heat power (W)",
+            ],
+        ),
+        (
+            "classes",
+            vec![
+                "release speed (r/min)",
+                "friction coefficient",
+                "pendulum vibration",
+                "failed",
+            ],
+        ),
+        (
+            "fig4_critical",
+            vec![
+                "friction coefficient",
+                "critical whirl speed (r/min)",
+                "pendulum vibration",
+                "backward whirl",
+                "no whirl up to",
+            ],
+        ),
+        (
+            "fig3_orbits",
+            vec!["x (µm)", "y (µm)", "pendulum vibration", "clearance circle"],
+        ),
+    ];
+    assert_eq!(written.len(), stems.len() * 2, "{written:?}");
+    for (stem, labels) in &stems {
+        let png = dir.join("charts").join(format!("{stem}.png"));
+        let svg = dir.join("charts").join(format!("{stem}.svg"));
+        assert!(written.contains(&png) && written.contains(&svg), "{stem}");
+        let bytes = std::fs::read(&png).unwrap();
+        assert!(bytes.len() > 1000, "{stem}.png is {} bytes", bytes.len());
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{stem}.png signature");
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(text.contains("<svg"), "{stem}.svg");
+        assert!(text.trim_end().ends_with("</svg>"), "{stem}.svg");
+        for label in labels {
+            assert!(text.contains(label), "{stem}.svg lacks {label:?}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn optional_charts_are_skipped_without_their_data() {
+    let dir = temp_dir("optional");
+    write_synthetic(&dir, 0);
+    std::fs::remove_file(dir.join("critical.json")).unwrap();
+    let written = render_all(&dir).unwrap();
+    let names: Vec<String> = written
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names.len(), 6, "{names:?}");
+    assert!(!names
+        .iter()
+        .any(|n| n.starts_with("fig4") || n.starts_with("fig3")));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Writes a fuller demo (four orbit panels) to `$WHIRLMAP_CHART_DEMO` for viewing by eye.
+#[test]
+fn demo_charts_for_viewing() {
+    let Some(dir) = std::env::var_os("WHIRLMAP_CHART_DEMO") else {
+        return;
+    };
+    let dir = PathBuf::from(dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    write_synthetic(&dir, 4);
+    for p in render_all(&dir).unwrap() {
+        println!("{}", p.display());
+    }
+}

@@ -1,0 +1,108 @@
+//! `whirlmap sweep FILE`: run a grid of drops from a JSON sweep spec.
+//!
+//! Exit codes: 0 every point ok; 1 some point failed (records still written); 2 bad spec or
+//! unwritable output folder (nothing run); 4 an output (records or charts) could not be
+//! written.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use whirlmap_sweep::spec;
+use whirlmap_sweep::sweep::{run_sweep, ProgressMode, RunOptions, SweepError};
+
+/// Arguments of `whirlmap sweep`.
+#[derive(clap::Args)]
+pub struct SweepArgs {
+    /// Sweep spec (JSON): name, scene overrides, duration_s, axes, optional critical, charts.
+    file: PathBuf,
+    /// Output folder; default `results/<name>`.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    threads: Option<u32>,
+    /// Keep the ok points of an existing points.jsonl and run only the rest.
+    #[arg(long)]
+    resume: bool,
+    /// No progress bar or progress lines.
+    #[arg(long)]
+    no_progress: bool,
+}
+
+/// Runs the subcommand and returns the process exit code.
+pub fn run(a: &SweepArgs) -> ExitCode {
+    let spec = match spec::load(&a.file) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let out_dir = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
+    let opts = RunOptions {
+        out_dir,
+        threads: a.threads.map(|n| n as usize),
+        resume: a.resume,
+        progress: if a.no_progress {
+            ProgressMode::Off
+        } else {
+            ProgressMode::Auto
+        },
+    };
+    let outcome = match run_sweep(&spec, &opts) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(match e {
+                SweepError::Spec(_) | SweepError::ThreadPool(_) => 2,
+                SweepError::Io { .. } => 4,
+            });
+        }
+    };
+    println!(
+        "sweep {}: {} points, {} ok, {} failed{}",
+        spec.name,
+        outcome.points,
+        outcome.ok,
+        outcome.failed,
+        if outcome.skipped > 0 {
+            format!(" ({} resumed)", outcome.skipped)
+        } else {
+            String::new()
+        }
+    );
+    for (class, n) in &outcome.classes {
+        println!("  {class:<16} {n}");
+    }
+    println!("  output           {}", outcome.out_dir.display());
+    match whirlmap_sweep::extras::run_all(&spec, &outcome.out_dir, opts.threads) {
+        Ok((critical, orbits)) => {
+            if let Some(p) = critical {
+                println!("  critical speeds  {}", p.display());
+            }
+            if !orbits.is_empty() {
+                println!("  orbits           {} drops recorded", orbits.len());
+            }
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(4);
+        }
+    }
+    if !spec.charts.is_empty() {
+        match whirlmap_sweep::charts::render_all(&outcome.out_dir) {
+            Ok(written) => println!("  charts           {} files", written.len()),
+            Err(e) => {
+                eprintln!("error: charts: {e}");
+                return ExitCode::from(4);
+            }
+        }
+    }
+    if outcome.failed > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}

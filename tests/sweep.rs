@@ -1,0 +1,349 @@
+//! End-to-end tests of `whirlmap sweep`: spec errors, determinism across thread counts,
+//! crash-safe resume, and failed points recorded as data.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_whirlmap");
+
+fn whirlmap(args: &[&str]) -> Output {
+    Command::new(BIN)
+        .args(args)
+        .output()
+        .expect("runs the binary")
+}
+
+/// A fresh temporary folder for one test.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("whirlmap-sweep-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn smoke_spec() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/smoke.json")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn lines(path: &Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("complete JSON lines"))
+        .collect()
+}
+
+#[test]
+fn bad_specs_exit_2_name_the_field_and_run_nothing() {
+    let dir = temp_dir("bad");
+    let base =
+        r#""name": "bad", "duration_s": 0.05, "axes": {"speed_rpm": [4000, 8000], "mu": [0.1]}"#;
+    let cases: &[(&str, String, &[&str])] = &[
+        ("unknown top-level key", format!("{{{base}, \"colour\": 1}}"), &["colour", "line"]),
+        (
+            "unknown scene key",
+            format!("{{{base}, \"scene\": {{\"clearence_m\": 1e-4}}}}"),
+            &["clearence_m", "column"],
+        ),
+        (
+            "type error",
+            r#"{"name": "bad", "duration_s": "long", "axes": {"mu": [0.1]}}"#.into(),
+            &["line", "column"],
+        ),
+        (
+            "empty axis",
+            r#"{"name": "bad", "duration_s": 0.05, "axes": {"mu": []}}"#.into(),
+            &["axes.mu", "empty"],
+        ),
+        (
+            "zero steps",
+            r#"{"name": "bad", "duration_s": 0.05, "axes": {"mu": {"from": 0.1, "to": 0.3, "steps": 0}}}"#.into(),
+            &["axes.mu.steps = 0"],
+        ),
+        (
+            "from > to",
+            r#"{"name": "bad", "duration_s": 0.05, "axes": {"speed_rpm": {"from": 9000, "to": 1000, "steps": 3}}}"#.into(),
+            &["axes.speed_rpm", "9000"],
+        ),
+        ("unknown chart", format!("{{{base}, \"charts\": [\"pie\"]}}"), &["charts", "pie"]),
+        (
+            "unknown axis",
+            r#"{"name": "bad", "duration_s": 0.05, "axes": {"clearence_m": [1e-4]}}"#.into(),
+            &["axes.clearence_m", "clearance_m"],
+        ),
+        (
+            "mu out of range",
+            r#"{"name": "bad", "duration_s": 0.05, "axes": {"mu": [0.1, 2.5]}}"#.into(),
+            &["axes.mu = 2.5"],
+        ),
+        (
+            "zero duration",
+            r#"{"name": "bad", "duration_s": 0, "axes": {"mu": [0.1]}}"#.into(),
+            &["duration_s = 0"],
+        ),
+        (
+            "invalid grid point scene",
+            r#"{"name": "bad", "duration_s": 0.05, "axes": {"clearance_m": [1e-4, -1e-3]}}"#.into(),
+            &["grid point 1", "clearance_m = -0.001"],
+        ),
+    ];
+    for (i, (what, text, needles)) in cases.iter().enumerate() {
+        let spec = dir.join(format!("case{i}.json"));
+        std::fs::write(&spec, text).unwrap();
+        let out_dir = dir.join(format!("out{i}"));
+        let o = whirlmap(&["sweep", s(&spec), "--out", s(&out_dir), "--no-progress"]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+        for n in *needles {
+            assert!(err.contains(n), "{what}: `{n}` not in: {err}");
+        }
+        assert!(
+            !out_dir.join("points.jsonl").exists(),
+            "{what}: points were written"
+        );
+    }
+    // An output folder that cannot be created (below a regular file).
+    let file = dir.join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let out_dir = file.join("out");
+    let o = whirlmap(&[
+        "sweep",
+        s(&smoke_spec()),
+        "--out",
+        s(&out_dir),
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("output folder"), "{}", stderr(&o));
+    // A missing file and a bad thread count.
+    let o = whirlmap(&["sweep", s(&dir.join("missing.json"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("missing.json"), "{}", stderr(&o));
+    let o = whirlmap(&["sweep", s(&smoke_spec()), "--threads", "0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn points_are_byte_identical_for_any_thread_count() {
+    let dir = temp_dir("threads");
+    let (a, b) = (dir.join("t1"), dir.join("t2"));
+    // Without --resume an existing points.jsonl is replaced.
+    std::fs::create_dir_all(&a).unwrap();
+    std::fs::write(a.join("points.jsonl"), "stale\n").unwrap();
+    for (out, threads) in [(&a, "1"), (&b, "2")] {
+        let o = whirlmap(&[
+            "sweep",
+            s(&smoke_spec()),
+            "--out",
+            s(out),
+            "--threads",
+            threads,
+            "--no-progress",
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        assert!(
+            o.stderr.is_empty(),
+            "--no-progress is silent: {}",
+            stderr(&o)
+        );
+        assert!(String::from_utf8_lossy(&o.stdout).contains("4 points"));
+    }
+    let pa = std::fs::read(a.join("points.jsonl")).unwrap();
+    let pb = std::fs::read(b.join("points.jsonl")).unwrap();
+    assert!(pa == pb, "points.jsonl differs between 1 and 2 threads");
+    let recs = lines(&a.join("points.jsonl"));
+    assert_eq!(recs.len(), 4);
+    for (i, r) in recs.iter().enumerate() {
+        assert_eq!(r["index"], i);
+        assert_eq!(r["status"], "ok");
+        assert_eq!(r["key"].as_str().unwrap().len(), 16);
+        assert!(r["record"]["class"].is_string());
+        assert!(r.get("wall_time_s").is_none());
+    }
+    let keys: Vec<_> = recs[0]["inputs"].as_object().unwrap().keys().collect();
+    assert_eq!(keys.len(), 2);
+    assert_eq!(
+        std::fs::read(a.join("summary.csv")).unwrap(),
+        std::fs::read(b.join("summary.csv")).unwrap()
+    );
+    let summary = std::fs::read_to_string(a.join("summary.csv")).unwrap();
+    assert!(
+        summary.starts_with("index,speed_rpm,mu,class,"),
+        "{summary}"
+    );
+    assert_eq!(summary.lines().count(), 5);
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(a.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(m["counts"]["points"], 4);
+    assert_eq!(m["counts"]["ok"], 4);
+    assert_eq!(m["spec"]["name"], "smoke");
+    assert_eq!(lines(&a.join("timings.jsonl")).len(), 4);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+const RESUME_SPEC: &str = r#"{
+  "name": "resume",
+  "scene": {"solver": {"rtol": 1e-9}},
+  "duration_s": 0.2,
+  "axes": {"speed_rpm": [2000, 4000, 6000, 8000], "mu": [0.1, 0.2, 0.3, 0.4]}
+}"#;
+
+#[test]
+fn a_killed_sweep_resumes_to_the_uninterrupted_file() {
+    let dir = temp_dir("resume");
+    let spec = dir.join("resume.json");
+    std::fs::write(&spec, RESUME_SPEC).unwrap();
+    let (full, killed) = (dir.join("full"), dir.join("killed"));
+
+    // Interrupted run: one thread, chunks of 4; kill once some but not all lines are in.
+    let mut child = Command::new(BIN)
+        .args([
+            "sweep",
+            s(&spec),
+            "--out",
+            s(&killed),
+            "--threads",
+            "1",
+            "--no-progress",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let points = killed.join("points.jsonl");
+    let start = Instant::now();
+    loop {
+        let n = std::fs::read_to_string(&points)
+            .map(|t| t.matches('\n').count())
+            .unwrap_or(0);
+        if n >= 2 {
+            assert!(n < 16, "the sweep finished before it could be killed");
+            child.kill().unwrap();
+            break;
+        }
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the sweep ended before writing 2 lines"
+        );
+        assert!(start.elapsed() < Duration::from_secs(60), "no progress");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.wait().unwrap();
+    let before = std::fs::read_to_string(&points).unwrap();
+    let complete = before.matches('\n').count();
+    assert!(
+        (2..16).contains(&complete),
+        "{complete} lines after the kill"
+    );
+    // A crash in the middle of a write leaves a torn line.
+    let mut torn = before.clone();
+    if !torn.ends_with('\n') {
+        torn.truncate(torn.rfind('\n').unwrap() + 1);
+    }
+    torn.push_str(r#"{"key":"0123456789abcdef","index":9,"inputs":{"speed_"#);
+    std::fs::write(&points, torn).unwrap();
+
+    let o = whirlmap(&[
+        "sweep",
+        s(&spec),
+        "--out",
+        s(&killed),
+        "--threads",
+        "2",
+        "--resume",
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+
+    let o = whirlmap(&[
+        "sweep",
+        s(&spec),
+        "--out",
+        s(&full),
+        "--threads",
+        "2",
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+
+    let recs = lines(&points);
+    assert_eq!(recs.len(), 16);
+    for (i, r) in recs.iter().enumerate() {
+        assert_eq!(r["index"], i, "every point exactly once, in grid order");
+    }
+    assert!(
+        std::fs::read(&points).unwrap() == std::fs::read(full.join("points.jsonl")).unwrap(),
+        "resumed points.jsonl differs from the uninterrupted run's"
+    );
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(killed.join("manifest.json")).unwrap())
+            .unwrap();
+    let skipped = m["counts"]["skipped"].as_u64().unwrap();
+    assert!((2..16).contains(&skipped), "skipped {skipped}");
+    assert_eq!(m["counts"]["ok"], 16);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_failed_point_is_recorded_and_the_sweep_goes_on() {
+    let dir = temp_dir("failed");
+    let spec = dir.join("failing.json");
+    std::fs::write(
+        &spec,
+        r#"{"name": "failing", "duration_s": 0.05,
+            "axes": {"solver.max_step_attempts": [10, 20000000], "mu": [0.1, 0.3]}}"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = whirlmap(&["sweep", s(&spec), "--out", s(&out), "--no-progress"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("2 failed"));
+    let recs = lines(&out.join("points.jsonl"));
+    assert_eq!(recs.len(), 4);
+    for r in &recs[..2] {
+        assert_eq!(r["status"], "failed", "{r}");
+        assert_eq!(r["error"]["kind"], "step_budget", "{r}");
+        assert!(r["error"]["message"]
+            .as_str()
+            .unwrap()
+            .contains("step budget"));
+        assert!(r.get("record").is_none());
+    }
+    for r in &recs[2..] {
+        assert_eq!(r["status"], "ok", "{r}");
+        assert!(r.get("error").is_none());
+    }
+    let summary = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    assert_eq!(
+        summary.lines().filter(|l| l.contains(",failed,")).count(),
+        2,
+        "{summary}"
+    );
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(m["counts"]["failed"], 2);
+    assert_eq!(m["counts"]["ok"], 2);
+
+    // Resume re-runs failed points (still failing here) and keeps one line per point.
+    let o = whirlmap(&[
+        "sweep",
+        s(&spec),
+        "--out",
+        s(&out),
+        "--resume",
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert_eq!(lines(&out.join("points.jsonl")).len(), 4);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
