@@ -315,8 +315,8 @@ pub fn assemble_grid(rows: &[PointRow]) -> Grid {
         .filter(|r| fixed.iter().all(|(k, v)| r.inputs.get(k) == Some(v)))
         .cloned()
         .collect();
-    let speed = |r: &PointRow| r.speed_rpm().unwrap_or(0.0);
-    let mu = |r: &PointRow| r.mu().unwrap_or(0.0);
+    let speed = |r: &PointRow| clamp_value(r.speed_rpm().unwrap_or(0.0));
+    let mu = |r: &PointRow| clamp_value(r.mu().unwrap_or(0.0));
     let speeds_rpm = distinct_sorted(slice.iter().map(speed));
     let mus = distinct_sorted(slice.iter().map(mu));
     let mut cells = vec![None; speeds_rpm.len() * mus.len()];
@@ -412,19 +412,12 @@ pub fn nice_levels(lo: f64, hi: f64, target: usize) -> Vec<f64> {
         .map(|m| m * mag)
         .find(|s| *s >= raw)
         .unwrap_or(10.0 * mag);
-    let mut levels = Vec::new();
-    let mut k = (lo / step).floor();
-    loop {
-        let v = k * step;
-        if v >= hi - span * 1e-6 {
-            break;
-        }
-        if v > lo + span * 1e-6 {
-            levels.push(v);
-        }
-        k += 1.0;
-    }
-    levels
+    let start = (lo / step).floor() * step;
+    // Bounded, so a step too small to move a huge start cannot loop forever.
+    (0..=target * 3 + 2)
+        .map(|k| start + k as f64 * step)
+        .filter(|v| *v > lo + span * 1e-6 && *v < hi - span * 1e-6)
+        .collect()
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -641,6 +634,24 @@ fn draw_mark<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Largest magnitude drawn: beyond it values are clamped, so spans stay finite.
+const VALUE_LIMIT: f64 = 1e300;
+
+fn clamp_value(v: f64) -> f64 {
+    v.clamp(-VALUE_LIMIT, VALUE_LIMIT)
+}
+
+/// The colour-scale colour of `v` in `lo..hi` (ends for anything outside, mid for NaN).
+fn scale_colour(v: f64, lo: f64, hi: f64) -> RGBColor {
+    let t = (v - lo) / (hi - lo);
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    ViridisRGB::get_color_normalized(t, 0.0, 1.0)
+}
+
 /// Cell edges around increasing centres: midpoints, extended by half a step at the ends.
 fn edges(centres: &[f64]) -> Vec<f64> {
     match centres.len() {
@@ -732,7 +743,9 @@ impl GridFigure<'_> {
         match self.mode {
             GridMode::Classes => CellKind::Class(class),
             GridMode::Metric(_) if class.is_whirl() => CellKind::Whirl(class),
-            GridMode::Metric(f) => f(row).map_or(CellKind::NoValue, CellKind::Value),
+            GridMode::Metric(f) => {
+                f(row).map_or(CellKind::NoValue, |v| CellKind::Value(clamp_value(v)))
+            }
         }
     }
 }
@@ -805,7 +818,7 @@ impl Figure for GridFigure<'_> {
                 match kinds[j * nx + i] {
                     CellKind::Value(v) => {
                         let (lo, hi) = scale.unwrap_or((0.0, 1.0));
-                        let c = ViridisRGB::get_color_normalized(v, lo, hi);
+                        let c = scale_colour(v, lo, hi);
                         canvas.draw(&Rectangle::new([tl, br], c.filled()))?;
                     }
                     CellKind::Class(c) => {
@@ -958,7 +971,7 @@ fn draw_colour_bar<DB: DrawingBackend>(
     bar.draw_series((0..STEPS).map(|k| {
         let a = lo + (hi - lo) * k as f64 / STEPS as f64;
         let b = lo + (hi - lo) * (k + 1) as f64 / STEPS as f64;
-        let c = ViridisRGB::get_color_normalized((a + b) / 2.0, lo, hi);
+        let c = scale_colour((a + b) / 2.0, lo, hi);
         Rectangle::new([(0.0, a), (1.0, b)], c.filled())
     }))?;
     bar.draw_series(
@@ -1063,14 +1076,25 @@ struct CriticalFigure<'a> {
 
 impl Figure for CriticalFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let mut entries: Vec<&CriticalEntry> =
-            self.entries.iter().filter(|e| e.mu.is_finite()).collect();
+        let mut entries: Vec<CriticalEntry> = self
+            .entries
+            .iter()
+            .filter(|e| e.mu.is_finite())
+            .cloned()
+            .map(|mut e| {
+                e.mu = clamp_value(e.mu);
+                let r = &mut e.result;
+                r.bracket = r.bracket.map(|b| b.map(clamp_value));
+                r.scanned.iter_mut().for_each(|s| s.0 = clamp_value(s.0));
+                e
+            })
+            .collect();
         entries.sort_by(|a, b| a.mu.total_cmp(&b.mu));
         let points: Vec<(f64, f64, &PointRow)> = self
             .grid
             .rows
             .iter()
-            .filter_map(|r| Some((r.mu()?, r.speed_rpm()?, r)))
+            .filter_map(|r| Some((clamp_value(r.mu()?), clamp_value(r.speed_rpm()?), r)))
             .collect();
 
         let mus = entries
@@ -1374,8 +1398,10 @@ impl Figure for OrbitPanels<'_> {
                 .iter()
                 .map(|s| (s.x_rel_m * 1e6, s.y_rel_m * 1e6))
                 .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .map(|(x, y)| (clamp_value(x), clamp_value(y)))
                 .collect();
-            let clearance = Some(o.orbit.clearance_m * 1e6).filter(|c| c.is_finite() && *c > 0.0);
+            let clearance =
+                Some(clamp_value(o.orbit.clearance_m * 1e6)).filter(|c| c.is_finite() && *c > 0.0);
             let extent = path
                 .iter()
                 .map(|(x, y)| x.abs().max(y.abs()))

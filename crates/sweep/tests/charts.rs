@@ -241,3 +241,29 @@ fn demo_charts_for_viewing() {
         println!("{}", p.display());
     }
 }
+
+#[test]
+fn extreme_values_neither_panic_nor_hang() {
+    let dir = temp_dir("extreme");
+    let lines = [
+        r#"{"key":"a","index":0,"inputs":{"speed_rpm":1000,"mu":0.1},"status":"ok","record":{"class":"pendulum","max_contact_force_n":1.7e308,"peak_heat_power_w":null}}"#,
+        r#"{"key":"b","index":1,"inputs":{"speed_rpm":2000,"mu":0.1},"status":"ok","record":{"class":"pendulum","max_contact_force_n":500.0,"peak_heat_power_w":1.0}}"#,
+        r#"{"key":"c","index":2,"inputs":{"speed_rpm":1000,"mu":0.2},"status":"ok","record":{"class":"pendulum","max_contact_force_n":500.0000000000001,"peak_heat_power_w":1.0}}"#,
+        r#"{"key":"d","index":3,"inputs":{"speed_rpm":2000,"mu":0.2},"status":"ok","record":{"class":"bouncing","max_contact_force_n":-1.7e308,"peak_heat_power_w":1.0}}"#,
+    ];
+    std::fs::write(dir.join("points.jsonl"), lines.join("\n")).unwrap();
+    std::fs::write(
+        dir.join("critical.json"),
+        r#"[{"mu":0.1,"result":{"bracket":[1.7e308,-1.7e308],"scanned":[]}},{"mu":0.2,"result":{"bracket":null,"class_lo":"backward_whirl","scanned":[]}}]"#,
+    )
+    .unwrap();
+    let odir = dir.join("orbits");
+    std::fs::create_dir_all(&odir).unwrap();
+    let orbit = r#"{"speed_rpm":1.7e308,"mu":0.1,"class":"pendulum","orbit":{"clearance_m":2e-4,"samples":[
+        {"t_s":0.0,"x_rel_m":0.0,"y_rel_m":0.0,"contact_force_n":0.0},
+        {"t_s":0.1,"x_rel_m":1.7e308,"y_rel_m":-1.7e308,"contact_force_n":1.7e308},
+        {"t_s":0.2,"x_rel_m":1e-5,"y_rel_m":1e-5,"contact_force_n":1.0}]}}"#;
+    std::fs::write(odir.join("huge.json"), orbit).unwrap();
+    assert_eq!(render_all(&dir).unwrap().len(), 10);
+    let _ = std::fs::remove_dir_all(&dir);
+}
