@@ -63,3 +63,49 @@ fn render_draws_charts_and_reports_exit_codes() {
     let _ = std::fs::remove_dir_all(&empty);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn design_charts_render_with_no_system_fonts() {
+    // The committed paper records, redrawn in a process where fontconfig finds no font at all:
+    // only the embedded DejaVu Sans can draw the labels.
+    let dir = temp_dir("nofonts");
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("results/paper");
+    for f in ["points.jsonl", "critical.json"] {
+        std::fs::copy(src.join(f), dir.join(f)).unwrap();
+    }
+    let fc = dir.join("empty-fonts.conf");
+    std::fs::write(&fc, "<?xml version=\"1.0\"?><!DOCTYPE fontconfig SYSTEM \"fonts.dtd\"><fontconfig></fontconfig>").unwrap();
+    let empty = dir.join("no-fonts-here");
+    std::fs::create_dir_all(&empty).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_whirlmap"))
+        .arg("render")
+        .arg(&dir)
+        .env("FONTCONFIG_FILE", &fc)
+        .env("FONTCONFIG_PATH", &empty)
+        .env("HOME", &empty)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for name in [
+        "fig5_max_force",
+        "fig6_peak_power",
+        "classes",
+        "fig4_critical",
+    ] {
+        let png = std::fs::read(dir.join("charts").join(format!("{name}.png"))).unwrap();
+        assert!(
+            png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 5000,
+            "{name}.png"
+        );
+        let svg = std::fs::read_to_string(dir.join("charts").join(format!("{name}.svg"))).unwrap();
+        assert!(
+            svg.contains("<svg") && svg.trim_end().ends_with("</svg>"),
+            "{name}.svg"
+        );
+        assert!(svg.contains("r/min"), "{name}.svg lacks its axis unit");
+    }
+}
