@@ -211,7 +211,10 @@ impl AxisValues {
                         if i + 1 == n {
                             *to
                         } else {
-                            from + (to - from) * (i as f64) / ((n - 1) as f64)
+                            // Rounded to 12 significant digits, so 0.05 + 2 * 0.05 is written
+                            // 0.15, not 0.15000000000000002, in records, keys and CSV.
+                            let v = from + (to - from) * (i as f64) / ((n - 1) as f64);
+                            format!("{v:.11e}").parse().unwrap_or(v)
                         }
                     })
                     .collect(),
