@@ -81,22 +81,19 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
     };
     let mut dy = [0.0; whirlmap_core::model::N];
     let n = 2_000_000;
-    let t = Instant::now();
-    for i in 0..n {
-        y[ix::TR] = i as f64 * 1e-9;
-        sys.rhs(0.0, black_box(&y), &mut dy);
-        black_box(&dy);
+    for (label, slip) in [
+        ("slipping", Slip::Slipping(1.0)),
+        ("sticking", Slip::Sticking),
+    ] {
+        sys.mode.slip = slip;
+        let t = Instant::now();
+        for i in 0..n {
+            y[ix::TR] = i as f64 * 1e-9;
+            sys.rhs(0.0, black_box(&y), &mut dy);
+            black_box(&dy);
+        }
+        let ns = t.elapsed().as_secs_f64() * 1e9 / n as f64;
+        println!("one RHS evaluation (contact, {label}, drag on): {ns:.1} ns");
     }
-    let ns = t.elapsed().as_secs_f64() * 1e9 / n as f64;
-    println!("one RHS evaluation (contact, slipping, drag on): {ns:.1} ns");
-    sys.mode.slip = Slip::Sticking;
-    let t = Instant::now();
-    for i in 0..n {
-        y[ix::TR] = i as f64 * 1e-9;
-        sys.rhs(0.0, black_box(&y), &mut dy);
-        black_box(&dy);
-    }
-    let ns = t.elapsed().as_secs_f64() * 1e9 / n as f64;
-    println!("one RHS evaluation (contact, sticking, drag on): {ns:.1} ns");
     Ok(())
 }

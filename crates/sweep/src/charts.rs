@@ -26,9 +26,9 @@ use whirlmap_core::orbit::Orbit;
 use crate::classify::OrbitClass;
 use crate::render::{
     chart_header, chart_mesh, chart_quantity, chart_text_style, chart_tick_formatter,
-    decimate_samples, render, DrawResult, Figure, RenderError, CHART_AXIS_DESC_FONT,
-    CHART_CAPTION_FONT, CHART_CLEARANCE_COLOUR, CHART_PATH_COLOUR, CHART_TICK_FONT,
-    CHART_TITLE_BAND, CHART_TITLE_FONT, CHART_X_LABEL_AREA, CHART_Y_LABEL_AREA,
+    decimate_samples, orbit_panel, render, DrawResult, Figure, RenderError, AXIS_DESC_FONT,
+    CAPTION_FONT, CLEARANCE_COLOUR, PATH_COLOUR, TICK_FONT, TITLE_BAND, TITLE_FONT, X_LABEL_AREA,
+    Y_LABEL_AREA,
 };
 
 /// Size (width, height) in pixels of the grid charts and Fig. 4.
@@ -536,7 +536,7 @@ fn legend<DB: DrawingBackend>(
     const MARK_W: i32 = 26;
     const GAP: i32 = 7;
     const ENTRY_GAP: i32 = 26;
-    let style = chart_text_style(CHART_TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center));
+    let style = chart_text_style(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center));
     let mut widths = Vec::new();
     for (_, label) in entries {
         widths.push(MARK_W + GAP + area.estimate_text_size(label, &style)?.0 as i32);
@@ -781,7 +781,7 @@ impl Figure for GridFigure<'_> {
         });
         let is_metric = matches!(self.mode, GridMode::Metric(_));
 
-        let body = chart_header(root, CHART_TITLE_BAND, &self.title, CHART_TITLE_FONT)?;
+        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (bw, bh) = body.dim_in_pixel();
         let (main, legend_band) = body.split_vertically(bh.saturating_sub(44));
         let (plot_area, bar_area) = if is_metric {
@@ -795,8 +795,8 @@ impl Figure for GridFigure<'_> {
             .margin_left(14)
             .margin_right(12)
             .margin_bottom(4)
-            .x_label_area_size(CHART_X_LABEL_AREA)
-            .y_label_area_size(CHART_Y_LABEL_AREA)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1])?;
         chart_mesh(&mut chart, SPEED_DESC, MU_DESC, 10, 8)?;
 
@@ -894,7 +894,7 @@ impl Figure for GridFigure<'_> {
                     &canvas,
                     "no values in scale",
                     (w as i32 / 2, h as i32 / 2),
-                    CHART_CAPTION_FONT,
+                    CAPTION_FONT,
                     CONTOUR,
                 )?;
             }
@@ -951,7 +951,7 @@ fn draw_colour_bar<DB: DrawingBackend>(
 ) -> DrawResult<DB> {
     let mut bar = ChartBuilder::on(area)
         .margin_top(12)
-        .margin_bottom(4 + CHART_X_LABEL_AREA)
+        .margin_bottom(4 + X_LABEL_AREA)
         .margin_left(8)
         .margin_right(4)
         .right_y_label_area_size(96)
@@ -963,8 +963,8 @@ fn draw_colour_bar<DB: DrawingBackend>(
         .y_labels(8)
         .y_label_formatter(&fmt)
         .y_desc(label)
-        .label_style(chart_text_style(CHART_TICK_FONT))
-        .axis_desc_style(chart_text_style(CHART_AXIS_DESC_FONT))
+        .label_style(chart_text_style(TICK_FONT))
+        .axis_desc_style(chart_text_style(AXIS_DESC_FONT))
         .axis_style(RGBColor(90, 90, 90).stroke_width(1))
         .draw()?;
     const STEPS: usize = 128;
@@ -1128,7 +1128,7 @@ impl Figure for CriticalFigure<'_> {
         // Range ends for the "no transition" markers: the scanned range, else the grid's.
         let grid_speed = bounds(points.iter().map(|p| p.1).collect());
 
-        let body = chart_header(root, CHART_TITLE_BAND, &self.title, CHART_TITLE_FONT)?;
+        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (_, bh) = body.dim_in_pixel();
         let (plot_area, legend_band) = body.split_vertically(bh.saturating_sub(60));
         let mut chart = ChartBuilder::on(&plot_area)
@@ -1136,8 +1136,8 @@ impl Figure for CriticalFigure<'_> {
             .margin_left(14)
             .margin_right(34)
             .margin_bottom(4)
-            .x_label_area_size(CHART_X_LABEL_AREA)
-            .y_label_area_size(CHART_Y_LABEL_AREA)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(x0..x1, y0..y1)?;
         chart_mesh(&mut chart, MU_DESC, "critical whirl speed (r/min)", 10, 8)?;
 
@@ -1260,14 +1260,14 @@ impl Figure for CriticalFigure<'_> {
             &canvas,
             "backward whirl",
             (w / 2, (h as f64 * 0.04) as i32 + 8),
-            CHART_CAPTION_FONT,
+            CAPTION_FONT,
             class_colour(OrbitClass::BackwardWhirl),
         )?;
         boxed_text(
             &canvas,
             "pendulum vibration",
             (w / 2, h - (h as f64 * 0.04) as i32 - 8),
-            CHART_CAPTION_FONT,
+            CAPTION_FONT,
             class_colour(OrbitClass::Pendulum),
         )?;
 
@@ -1374,13 +1374,13 @@ fn panel_layout(n: usize) -> (usize, usize) {
 fn orbit_figure_size(n: usize) -> (u32, u32) {
     let (cols, rows) = panel_layout(n);
     let w = (cols as u32 * 420).max(1000);
-    let h = CHART_TITLE_BAND + 44 + rows as u32 * if cols == 1 { 600 } else { 430 };
+    let h = TITLE_BAND + 44 + rows as u32 * if cols == 1 { 600 } else { 430 };
     (w, h.max(700))
 }
 
 impl Figure for OrbitPanels<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let body = chart_header(root, CHART_TITLE_BAND, &self.title, CHART_TITLE_FONT)?;
+        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (_, bh) = body.dim_in_pixel();
         let (panels_area, legend_band) = body.split_vertically(bh.saturating_sub(44));
         let (cols, rows) = panel_layout(self.orbits.len());
@@ -1392,7 +1392,7 @@ impl Figure for OrbitPanels<'_> {
                 chart_quantity(o.speed_rpm),
                 o.class_label()
             );
-            let plot = chart_header(area, 34, &caption, CHART_CAPTION_FONT)?;
+            let plot = chart_header(area, 34, &caption, CAPTION_FONT)?;
             let samples = decimate_samples(&o.orbit.samples, 8_000);
             let path: Vec<(f64, f64)> = samples
                 .iter()
@@ -1402,67 +1402,17 @@ impl Figure for OrbitPanels<'_> {
                 .collect();
             let clearance =
                 Some(clamp_value(o.orbit.clearance_m * 1e6)).filter(|c| c.is_finite() && *c > 0.0);
-            let extent = path
-                .iter()
-                .map(|(x, y)| x.abs().max(y.abs()))
-                .chain(clearance)
-                .fold(0.0_f64, f64::max);
-            let half = if extent > 0.0 && extent.is_finite() {
-                extent * 1.08
-            } else {
-                1.0
-            };
-
-            // A square plotting area, centred, for an equal aspect.
-            let (w, h) = plot.dim_in_pixel();
-            let (x_lab, y_lab) = (50_u32, 70_u32);
-            let side = h
-                .saturating_sub(8 + 6 + x_lab)
-                .min(w.saturating_sub(y_lab + 20))
-                .max(1);
-            let spare = w.saturating_sub(side + y_lab);
-            let margin_left = spare / 2;
-            let mut chart = ChartBuilder::on(&plot)
-                .margin_top(8)
-                .margin_bottom(h.saturating_sub(8 + side + x_lab))
-                .margin_left(margin_left)
-                .margin_right(spare - margin_left)
-                .x_label_area_size(x_lab)
-                .y_label_area_size(y_lab)
-                .build_cartesian_2d(-half..half, -half..half)?;
-            chart_mesh(&mut chart, "x (µm)", "y (µm)", 7, 7)?;
-            if let Some(c) = clearance {
-                let circle = (0..=360).map(|k| {
-                    let a = (k as f64).to_radians();
-                    (c * a.cos(), c * a.sin())
-                });
-                chart.draw_series(DashedLineSeries::new(
-                    circle,
-                    8,
-                    5,
-                    CHART_CLEARANCE_COLOUR.stroke_width(2),
-                ))?;
-            }
-            chart.draw_series(LineSeries::new(
-                path.iter().copied(),
-                CHART_PATH_COLOUR.stroke_width(1),
-            ))?;
-            if let (Some(&a), Some(&b)) = (path.first(), path.last()) {
-                chart.draw_series([
-                    Circle::new(a, 5, START_COLOUR.filled()),
-                    Circle::new(b, 5, END_COLOUR.filled()),
-                ])?;
-            }
+            orbit_panel(&plot, &path, clearance, (50, 70), 7)?;
         }
         legend(
             &legend_band,
             &[
                 (
-                    Mark::Line(CHART_PATH_COLOUR),
+                    Mark::Line(PATH_COLOUR),
                     "rotor-centre path relative to the race".to_string(),
                 ),
                 (
-                    Mark::Dashed(CHART_CLEARANCE_COLOUR),
+                    Mark::Dashed(CLEARANCE_COLOUR),
                     "clearance circle".to_string(),
                 ),
                 (Mark::Dot(START_COLOUR), "release".to_string()),

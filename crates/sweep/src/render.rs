@@ -189,28 +189,96 @@ pub fn decimate_samples(samples: &[OrbitSample], max_points: usize) -> Vec<Orbit
 // ---------------------------------------------------------------------------------------------
 // Shared styling and layout helpers for all charts.
 
+/// Draws an orbit panel into `plot`: a square, centred, equal-aspect plot of the rotor-centre
+/// path (µm) about the race centre, the clearance circle dashed, release and end dotted.
+/// Shared by the single-drop chart and the Fig. 3 grid; `label_areas` are the x and y label
+/// areas (px), `ticks` the tick count on each axis.
+pub(crate) fn orbit_panel<DB: DrawingBackend>(
+    plot: &DrawingArea<DB, Shift>,
+    path: &[(f64, f64)],
+    clearance: Option<f64>,
+    label_areas: (u32, u32),
+    ticks: usize,
+) -> DrawResult<DB> {
+    let (x_lab, y_lab) = label_areas;
+    // Symmetric range about the race centre covering the circle and every point.
+    let extent = path
+        .iter()
+        .map(|(x, y)| x.abs().max(y.abs()))
+        .chain(clearance)
+        .fold(0.0_f64, f64::max);
+    let extent = if extent > 0.0 && extent.is_finite() {
+        extent.min(AXIS_LIMIT)
+    } else {
+        1.0
+    };
+    let half = extent * 1.08;
+
+    // Square plotting area, centred horizontally, so the symmetric range is equal-aspect.
+    let (w, h) = plot.dim_in_pixel();
+    let (margin_top, margin_bottom) = (8_u32, 6_u32);
+    let side = h
+        .saturating_sub(margin_top + margin_bottom + x_lab)
+        .min(w.saturating_sub(y_lab + 20))
+        .max(1);
+    let spare = w.saturating_sub(side + y_lab);
+    // Centre plot and label area together, so narrow panels keep their axis titles.
+    let margin_left = spare / 2;
+    let margin_right = spare - margin_left;
+    let mut chart = ChartBuilder::on(plot)
+        .margin_top(margin_top)
+        .margin_bottom(h.saturating_sub(margin_top + side + x_lab))
+        .margin_left(margin_left)
+        .margin_right(margin_right)
+        .x_label_area_size(x_lab)
+        .y_label_area_size(y_lab)
+        .build_cartesian_2d(-half..half, -half..half)?;
+    draw_mesh(&mut chart, "x (µm)", "y (µm)", ticks, ticks)?;
+
+    if let Some(c) = clearance {
+        let circle = (0..=360).map(|k| {
+            let a = (k as f64).to_radians();
+            (c * a.cos(), c * a.sin())
+        });
+        chart.draw_series(DashedLineSeries::new(
+            circle,
+            8,
+            5,
+            CLEARANCE_COLOUR.stroke_width(2),
+        ))?;
+    }
+    draw_thin_line(&mut chart, path, PATH_COLOUR)?;
+    if let (Some(&first), Some(&last)) = (path.first(), path.last()) {
+        chart.draw_series([
+            Circle::new(first, 5, START_COLOUR.filled()),
+            Circle::new(last, 5, END_COLOUR.filled()),
+        ])?;
+    }
+    Ok(())
+}
+
 /// Figure title font size (px).
-const TITLE_FONT: f64 = 26.0;
+pub(crate) const TITLE_FONT: f64 = 26.0;
 /// Panel caption font size (px).
-const CAPTION_FONT: f64 = 19.0;
+pub(crate) const CAPTION_FONT: f64 = 19.0;
 /// Axis description font size (px).
-const AXIS_DESC_FONT: f64 = 17.0;
+pub(crate) const AXIS_DESC_FONT: f64 = 17.0;
 /// Tick label and legend font size (px).
-const TICK_FONT: f64 = 15.0;
+pub(crate) const TICK_FONT: f64 = 15.0;
 /// Height of the band holding the figure title (px).
-const TITLE_BAND: u32 = 50;
+pub(crate) const TITLE_BAND: u32 = 50;
 /// Space for the x tick labels and axis description below a plot (px).
-const X_LABEL_AREA: u32 = 58;
+pub(crate) const X_LABEL_AREA: u32 = 58;
 /// Space for the y tick labels and axis description left of a plot (px).
-const Y_LABEL_AREA: u32 = 82;
+pub(crate) const Y_LABEL_AREA: u32 = 82;
 
 const TEXT_COLOUR: RGBColor = RGBColor(30, 30, 30);
 const AXIS_COLOUR: RGBColor = RGBColor(90, 90, 90);
 const GRID_BOLD: RGBColor = RGBColor(212, 212, 212);
 const GRID_LIGHT: RGBColor = RGBColor(236, 236, 236);
-const PATH_COLOUR: RGBColor = RGBColor(31, 119, 180);
+pub(crate) const PATH_COLOUR: RGBColor = RGBColor(31, 119, 180);
 const FORCE_COLOUR: RGBColor = RGBColor(190, 50, 40);
-const CLEARANCE_COLOUR: RGBColor = RGBColor(120, 120, 120);
+pub(crate) const CLEARANCE_COLOUR: RGBColor = RGBColor(120, 120, 120);
 const START_COLOUR: RGBColor = RGBColor(44, 160, 44);
 const END_COLOUR: RGBColor = RGBColor(214, 39, 40);
 
@@ -477,59 +545,13 @@ impl OrbitFigure<'_> {
             legend.iter().map(|(m, t)| (*m, t.as_str())).collect();
         draw_legend_row(&legend_band, &legend)?;
 
-        // Symmetric range about the race centre covering the circle and every point.
-        let extent = path
-            .iter()
-            .map(|(x, y)| x.abs().max(y.abs()))
-            .chain(clearance)
-            .fold(0.0_f64, f64::max);
-        let extent = if extent > 0.0 && extent.is_finite() {
-            extent.min(AXIS_LIMIT)
-        } else {
-            1.0
-        };
-        let half = extent * 1.08;
-
-        // Square plotting area, centred horizontally, so the symmetric range is equal-aspect.
-        let (w, h) = plot_area.dim_in_pixel();
-        let (margin_top, margin_bottom) = (8_u32, 6_u32);
-        let side = h
-            .saturating_sub(margin_top + margin_bottom + X_LABEL_AREA)
-            .min(w.saturating_sub(Y_LABEL_AREA + 20))
-            .max(1);
-        let spare = w.saturating_sub(side + Y_LABEL_AREA);
-        let margin_right = (w.saturating_sub(side) / 2).min(spare);
-        let margin_left = spare - margin_right;
-        let mut chart = ChartBuilder::on(&plot_area)
-            .margin_top(margin_top)
-            .margin_bottom(h.saturating_sub(margin_top + side + X_LABEL_AREA))
-            .margin_left(margin_left)
-            .margin_right(margin_right)
-            .x_label_area_size(X_LABEL_AREA)
-            .y_label_area_size(Y_LABEL_AREA)
-            .build_cartesian_2d(-half..half, -half..half)?;
-        draw_mesh(&mut chart, "x (µm)", "y (µm)", 9, 9)?;
-
-        if let Some(c) = clearance {
-            let circle = (0..=360).map(|k| {
-                let a = (k as f64).to_radians();
-                (c * a.cos(), c * a.sin())
-            });
-            chart.draw_series(DashedLineSeries::new(
-                circle,
-                8,
-                5,
-                CLEARANCE_COLOUR.stroke_width(2),
-            ))?;
-        }
-        draw_thin_line(&mut chart, &path, PATH_COLOUR)?;
-        if let (Some(&first), Some(&last)) = (path.first(), path.last()) {
-            chart.draw_series([
-                Circle::new(first, 5, START_COLOUR.filled()),
-                Circle::new(last, 5, END_COLOUR.filled()),
-            ])?;
-        }
-        Ok(())
+        orbit_panel(
+            &plot_area,
+            &path,
+            clearance,
+            (X_LABEL_AREA, Y_LABEL_AREA),
+            9,
+        )
     }
 
     /// Bottom panel: contact force against time.
@@ -590,25 +612,6 @@ impl OrbitFigure<'_> {
 
 // ---------------------------------------------------------------------------------------------
 // Crate-internal access to the shared styling helpers, for the design charts (`crate::charts`).
-
-/// Figure title font size (px), shared with [`crate::charts`].
-pub(crate) const CHART_TITLE_FONT: f64 = TITLE_FONT;
-/// Panel caption font size (px), shared with [`crate::charts`].
-pub(crate) const CHART_CAPTION_FONT: f64 = CAPTION_FONT;
-/// Axis description font size (px), shared with [`crate::charts`].
-pub(crate) const CHART_AXIS_DESC_FONT: f64 = AXIS_DESC_FONT;
-/// Tick label and legend font size (px), shared with [`crate::charts`].
-pub(crate) const CHART_TICK_FONT: f64 = TICK_FONT;
-/// Height of the title band (px), shared with [`crate::charts`].
-pub(crate) const CHART_TITLE_BAND: u32 = TITLE_BAND;
-/// Space below a plot for x ticks and description (px), shared with [`crate::charts`].
-pub(crate) const CHART_X_LABEL_AREA: u32 = X_LABEL_AREA;
-/// Space left of a plot for y ticks and description (px), shared with [`crate::charts`].
-pub(crate) const CHART_Y_LABEL_AREA: u32 = Y_LABEL_AREA;
-/// Clearance-circle colour, shared with [`crate::charts`].
-pub(crate) const CHART_CLEARANCE_COLOUR: RGBColor = CLEARANCE_COLOUR;
-/// Orbit path colour, shared with [`crate::charts`].
-pub(crate) const CHART_PATH_COLOUR: RGBColor = PATH_COLOUR;
 
 /// The embedded-font text style of `size` px in the chart text colour.
 pub(crate) fn chart_text_style(size: f64) -> TextStyle<'static> {
