@@ -4,9 +4,11 @@
 use crate::error::{InvalidParameter, SolveError};
 use crate::model::{ix, DropSystem, Mode, Slip, N};
 use crate::monitor::{Features, Monitor};
-use crate::ode::{integrate, Dopri5, NoObserver, Observer, Stats, StepControl, StepView, Stop};
+use crate::ode::{
+    integrate, Dop853, Dopri5, NoObserver, Observer, Stats, StepControl, StepView, Stepper, Stop,
+};
 use crate::orbit::Orbit;
-use crate::scene::Scene;
+use crate::scene::{Method, Scene};
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
 
@@ -208,10 +210,24 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
 ) -> Result<DropReport, SolveError> {
     scene.validate()?;
     opts.validate()?;
-    let mut sys = DropSystem::new(scene);
+    let sys = DropSystem::new(scene);
+    let ctl = tolerances(scene, &sys);
+    match scene.solver.method {
+        Method::Dopri5 => run_with(scene, opts, extra, sys, Dopri5::new(ctl)),
+        Method::Dop853 => run_with(scene, opts, extra, sys, Dop853::new(ctl)),
+    }
+}
+
+/// The drop loop for one stepper type.
+fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
+    scene: &Scene,
+    opts: &DropOptions,
+    extra: &mut O,
+    mut sys: DropSystem,
+    mut stepper: M,
+) -> Result<DropReport, SolveError> {
     let mut y = sys.initial_state(scene.spin_rad_s());
     let e0 = sys.mechanical_energy(&y, sys.mode);
-    let mut stepper = Dopri5::new(tolerances(scene, &sys));
     let mut mon = Monitor::new(
         opts.duration_s,
         opts.impact_merge_s,
@@ -239,10 +255,10 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
             Stop::EndTime => break StopReason::DurationReached,
             Stop::Observer => break StopReason::WhirlTurnsReached,
             Stop::Event { index } => {
-                if stepper.stats.events >= scene.solver.max_events {
+                if stepper.stats().events >= scene.solver.max_events {
                     return Err(SolveError::EventBudget {
                         t_s: t,
-                        events: stepper.stats.events,
+                        events: stepper.stats().events,
                     });
                 }
                 let old = sys.mode;
@@ -280,7 +296,7 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
     Ok(DropReport {
         features,
         energy,
-        stats: stepper.stats,
+        stats: stepper.stats(),
         end_time_s: t,
         stop_reason,
         orbit,

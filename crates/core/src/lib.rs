@@ -53,4 +53,4 @@ pub use drop::{
 };
 pub use error::{InvalidParameter, SolveError};
 pub use monitor::{Features, Window};
-pub use scene::{FrictionLaw, Scene, SolverSettings};
+pub use scene::{FrictionLaw, Method, Scene, SolverSettings};

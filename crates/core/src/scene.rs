@@ -23,6 +23,26 @@ pub enum FrictionLaw {
     },
 }
 
+/// The Runge-Kutta pair a drop is integrated with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Dormand-Prince 5(4) with 4th-order dense output: the default.
+    #[default]
+    Dopri5,
+    /// Hairer's DOP853, 8(5,3) with 7th-order dense output: the independent reference of
+    /// `whirlmap accuracy` (see `ode/dop853.rs` for why it is hand-written).
+    Dop853,
+}
+
+impl Method {
+    /// True for the default (so the field is left out of the canonical JSON and the scene
+    /// hash of every existing record stays what it was).
+    pub fn is_default(&self) -> bool {
+        *self == Method::Dopri5
+    }
+}
+
 /// Integrator settings that change results (so they are part of the scene and its hash).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -43,6 +63,10 @@ pub struct SolverSettings {
     pub max_step_attempts: u64,
     /// Located mode switches before a typed budget error (chatter guard). Default 2 000 000.
     pub max_events: u64,
+    /// The Runge-Kutta pair. Default `dopri5`; `dop853` is the reference integrator.
+    /// Omitted from the canonical JSON (and the hash) while it is the default.
+    #[serde(skip_serializing_if = "Method::is_default")]
+    pub method: Method,
 }
 
 impl Default for SolverSettings {
@@ -54,6 +78,7 @@ impl Default for SolverSettings {
             min_step_s: 1e-13,
             max_step_attempts: 20_000_000,
             max_events: 2_000_000,
+            method: Method::Dopri5,
         }
     }
 }
@@ -142,6 +167,16 @@ pub struct Scene {
     pub whirl_stop_turns: f64,
     /// Integrator settings.
     pub solver: SolverSettings,
+
+    // ---- reduced models (issue 5; each default off, and then left out of the JSON) -------
+    /// Reduced model: the race's *translation* is massless (quasi-static). The race centre
+    /// then follows from the force balance between the rotor contact and the ball support
+    /// (two Hertz springs in series, see `model/quasi_static.rs`); its rotation keeps its
+    /// inertia. This removes the stiff light-race mode (about 16 kHz) that limits the step of
+    /// an explicit integrator. Its accuracy cost is measured by `whirlmap accuracy`.
+    /// Default false (the paper's model). Omitted from the canonical JSON while false.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub quasi_static_race: bool,
 }
 
 impl Default for Scene {
@@ -185,6 +220,7 @@ impl Scene {
             drag_zero_speed_rad_s: 0.1,
             whirl_stop_turns: 5.0,
             solver: SolverSettings::default(),
+            quasi_static_race: false,
         }
     }
 

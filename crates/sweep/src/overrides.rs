@@ -41,9 +41,23 @@ pub fn apply_assignment(scene: &mut Scene, assignment: &str) -> Result<(), Overr
     apply(scene, key.trim(), value)
 }
 
+/// Fields the canonical JSON leaves out while they hold their default (so scene hashes of
+/// older records stay valid) are still settable: put their defaults back in.
+fn show_optional_fields(root: &mut Value) {
+    if let Value::Object(m) = root {
+        m.entry("quasi_static_race").or_insert(Value::Bool(false));
+        if let Some(Value::Object(solver)) = m.get_mut("solver") {
+            solver
+                .entry("method")
+                .or_insert(Value::String("dopri5".into()));
+        }
+    }
+}
+
 /// Sets the scene parameter `key` (dotted for nested fields) to `value`.
 pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideError> {
     let mut root = serde_json::to_value(&*scene).expect("a scene serialises");
+    show_optional_fields(&mut root);
     let mut node = &mut root;
     let parts: Vec<&str> = key.split('.').collect();
     for (i, part) in parts.iter().enumerate() {
@@ -88,6 +102,17 @@ mod tests {
         apply_assignment(&mut s, "solver.rtol = 1e-7").unwrap();
         apply_assignment(&mut s, r#"friction_law={"regularised":{"v_eps_m_s":0.01}}"#).unwrap();
         apply_assignment(&mut s, "mu_static=0.4").unwrap();
+        apply_assignment(&mut s, "quasi_static_race=true").unwrap();
+        apply_assignment(&mut s, "solver.method=dop853").unwrap();
+        assert!(s.quasi_static_race);
+        assert_eq!(s.solver.method, whirlmap_core::Method::Dop853);
+        apply_assignment(&mut s, "quasi_static_race=false").unwrap();
+        apply_assignment(&mut s, "solver.method=dopri5").unwrap();
+        let text = serde_json::to_string(&s).unwrap();
+        assert!(
+            !text.contains("quasi_static_race") && !text.contains("method"),
+            "defaults of the optional fields stay out of the canonical JSON: {text}"
+        );
         assert_eq!(s.clearance_m, 2e-4);
         assert_eq!(s.solver.rtol, 1e-7);
         assert_eq!(s.friction_law, FrictionLaw::Regularised { v_eps_m_s: 0.01 });

@@ -12,6 +12,7 @@
 pub mod drag;
 pub mod friction;
 pub mod hertz;
+pub mod quasi_static;
 
 use crate::ode::{OdeSystem, MAX_GUARDS};
 use crate::scene::{FrictionLaw, Scene};
@@ -131,6 +132,8 @@ pub struct DropSystem {
     free_max_step: f64,
     f_ref: f64,
     f_ref_b: f64,
+    /// Reduced model: massless race translation (series springs), when the scene asks.
+    series: Option<quasi_static::SeriesSprings>,
     /// The current mode; the driver switches it at located events.
     pub mode: Mode,
 }
@@ -171,6 +174,14 @@ impl DropSystem {
             free_max_step: scene.solver.free_flight_max_step_s,
             f_ref: (m_r * g).max(1e-3),
             f_ref_b: (m_b * g).max(1e-6),
+            series: scene.quasi_static_race.then(|| {
+                quasi_static::SeriesSprings::new(
+                    scene.contact_stiffness_n_per_m_e,
+                    scene.contact_exponent,
+                    scene.support_stiffness_n_per_m_e,
+                    scene.support_exponent,
+                )
+            }),
             mode: Mode {
                 contact: false,
                 support: true,
@@ -185,7 +196,9 @@ impl DropSystem {
     pub fn initial_state(&mut self, spin_rad_s: f64) -> [f64; N] {
         let mut y = [0.0; N];
         y[ix::WR] = spin_rad_s;
-        y[ix::YB] = -(self.m_b * self.g / self.k2).powf(1.0 / self.e2);
+        if self.series.is_none() {
+            y[ix::YB] = -(self.m_b * self.g / self.k2).powf(1.0 / self.e2);
+        }
         self.mode = Mode {
             contact: false,
             support: self.g > 0.0,
@@ -231,8 +244,16 @@ impl DropSystem {
             ax_r = fx / self.m_r + self.e * (al_r * sp + w2 * cp);
             ay_r = fy / self.m_r - self.g - self.e * (al_r * cp - w2 * sp);
         }
-        let ax_b = (f.normal_n * n[0] + ft * t[0] + support_vec[0]) / self.m_b;
-        let ay_b = (f.normal_n * n[1] + ft * t[1] + support_vec[1]) / self.m_b - self.g;
+        let (ax_b, ay_b) = if self.series.is_some() {
+            // Massless race translation: the race centre stays at the housing centre in
+            // the state; its displacement lives in the series split.
+            (0.0, 0.0)
+        } else {
+            (
+                (f.normal_n * n[0] + ft * t[0] + support_vec[0]) / self.m_b,
+                (f.normal_n * n[1] + ft * t[1] + support_vec[1]) / self.m_b - self.g,
+            )
+        };
         let al_b = (ft * self.r_b + f.drag_torque_n_m) / self.j_b;
         [ax_r, ay_r, al_r, ax_b, ay_b, al_b]
     }
@@ -270,7 +291,18 @@ impl DropSystem {
         f.delta_dot_m_s = dvx * f.n[0] + dvy * f.n[1];
         let v_t = dvx * f.t[0] + dvy * f.t[1];
         f.v_rel_m_s = v_t + y[ix::WR] * self.r_r - y[ix::WB] * self.r_b;
-        f.normal_raw_n = hertz::raw_force(self.k1, self.e1, self.c1, f.delta_m, f.delta_dot_m_s);
+        // Quasi-static race: the series springs' force and the split damper (see
+        // `quasi_static`); otherwise eq. 7 between rotor and race.
+        let mut c_contact = self.c1;
+        if let Some(ss) = &self.series {
+            let sp = ss.split(f.delta_m);
+            let w = sp.w_contact;
+            c_contact = self.c1 * w * w + self.c2 * (1.0 - w) * (1.0 - w);
+            f.normal_raw_n = sp.force_n + c_contact * f.delta_dot_m_s;
+        } else {
+            f.normal_raw_n =
+                hertz::raw_force(self.k1, self.e1, self.c1, f.delta_m, f.delta_dot_m_s);
+        }
         if mode.contact {
             f.normal_n = f.normal_raw_n;
         }
@@ -280,7 +312,11 @@ impl DropSystem {
         let r = (bx * bx + by * by).sqrt();
         let mut support_vec = [0.0; 2];
         let mut r_dot = 0.0;
-        if r > 0.0 {
+        if self.series.is_some() {
+            // The support carries the contact force; its guard never fires.
+            f.support_raw_n = self.f_ref_b;
+            f.support_n = f.normal_n.max(0.0);
+        } else if r > 0.0 {
             let nb = [bx / r, by / r];
             r_dot = y[ix::VXB] * nb[0] + y[ix::VYB] * nb[1];
             f.support_raw_n = hertz::raw_force(self.k2, self.e2, self.c2, r, r_dot);
@@ -324,7 +360,7 @@ impl DropSystem {
         f.friction_n = ft;
         f.friction_power_w = ft * f.v_rel_m_s;
         f.damping_power_w = if mode.contact {
-            self.c1 * f.delta_dot_m_s * f.delta_dot_m_s
+            c_contact * f.delta_dot_m_s * f.delta_dot_m_s
         } else {
             0.0
         } + if mode.support {
@@ -373,6 +409,13 @@ impl DropSystem {
             + 0.5 * self.j_b * y[ix::WB].powi(2);
         let pe = self.g * (self.m_r * yc + self.m_b * y[ix::YB]);
         let mut el = 0.0;
+        if let Some(ss) = &self.series {
+            if mode.contact {
+                let dist = (y[ix::XR].powi(2) + y[ix::YR].powi(2)).sqrt();
+                el += ss.energy_j(&ss.split(dist - self.s));
+            }
+            return ke_r + ke_b + pe + el;
+        }
         if mode.contact {
             let dist = ((y[ix::XR] - y[ix::XB]).powi(2) + (y[ix::YR] - y[ix::YB]).powi(2)).sqrt();
             el += hertz::elastic_energy(self.k1, self.e1, dist - self.s);

@@ -4,7 +4,7 @@
 //! J. Comp. Appl. Math. 6 (1980); dense output and controller as in E. Hairer, S. P. Nørsett,
 //! G. Wanner, "Solving Ordinary Differential Equations I", 2nd ed., Sec. II.4-II.6 (DOPRI5).
 
-use super::{OdeSystem, Stats};
+use super::{OdeSystem, Stats, Stepper};
 use crate::error::SolveError;
 
 const C2: f64 = 1.0 / 5.0;
@@ -60,15 +60,21 @@ pub struct StepControl<const N: usize> {
     pub fixed_step: Option<f64>,
 }
 
-/// The 4th-order continuous extension of one accepted step, valid on `[t0, t_end]`.
+/// The continuous extension of one accepted step, valid on `[t0, t_end]`: DOPRI5's
+/// 4th-order one (5 coefficient vectors) or DOP853's 7th-order one (8).
+///
+/// Both share Hairer's nested form `r0 + th (r1 + th1 (r2 + th (r3 + th1 (r4 + ...))))`
+/// with `th = (t - t0)/h`, `th1 = 1 - th`, so one type serves both steppers.
 #[derive(Debug, Clone)]
 pub struct Dense<const N: usize> {
-    t0: f64,
-    h: f64,
-    t_end: f64,
-    r: [[f64; N]; 5],
-    /// The step's 5th-order end state, kept exactly (not re-summed from `r`).
-    y1: [f64; N],
+    pub(super) t0: f64,
+    pub(super) h: f64,
+    pub(super) t_end: f64,
+    /// Number of coefficient vectors in use: 5 (DOPRI5) or 8 (DOP853).
+    pub(super) terms: usize,
+    pub(super) r: [[f64; N]; 8],
+    /// The step's end state, kept exactly (not re-summed from `r`).
+    pub(super) y1: [f64; N],
 }
 
 impl<const N: usize> Dense<N> {
@@ -86,10 +92,16 @@ impl<const N: usize> Dense<N> {
         let th = (t - self.t0) / self.h;
         let th1 = 1.0 - th;
         let mut y = [0.0; N];
-        for i in 0..N {
-            y[i] = self.r[0][i]
-                + th * (self.r[1][i]
-                    + th1 * (self.r[2][i] + th * (self.r[3][i] + th1 * self.r[4][i])));
+        let r = &self.r;
+        if self.terms == 5 {
+            for i in 0..N {
+                y[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
+            }
+        } else {
+            for i in 0..N {
+                let inner = r[4][i] + th * (r[5][i] + th1 * (r[6][i] + th * r[7][i]));
+                y[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * inner)));
+            }
         }
         y
     }
@@ -105,6 +117,29 @@ impl<const N: usize> Dense<N> {
             self.eval(self.t_end)
         }
     }
+}
+
+/// A first step from Hairer's `hinit` (the simple form): 1 % of the ratio of the state's
+/// and the derivative's weighted norms, capped by `max_step` and floored at `10 h_min`.
+pub(super) fn initial_step<const N: usize>(
+    ctl: &StepControl<N>,
+    y: &[f64; N],
+    dy: &[f64; N],
+    max_step: f64,
+) -> f64 {
+    let (mut d0, mut d1) = (0.0, 0.0);
+    for i in 0..N {
+        let sc = ctl.atol[i] + ctl.rtol * y[i].abs();
+        d0 += (y[i] / sc).powi(2);
+        d1 += (dy[i] / sc).powi(2);
+    }
+    let (d0, d1) = ((d0 / N as f64).sqrt(), (d1 / N as f64).sqrt());
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    h0.min(max_step).max(ctl.h_min * 10.0)
 }
 
 /// The stepper: stage storage, the FSAL derivative, controller memory and work counters.
@@ -133,7 +168,8 @@ impl<const N: usize> Dopri5<N> {
                 t0: 0.0,
                 h: 1.0,
                 t_end: 0.0,
-                r: [[0.0; N]; 5],
+                terms: 5,
+                r: [[0.0; N]; 8],
                 y1: [0.0; N],
             },
             dy_last: [0.0; N],
@@ -150,19 +186,7 @@ impl<const N: usize> Dopri5<N> {
             return;
         }
         if self.h == 0.0 {
-            let (mut d0, mut d1) = (0.0, 0.0);
-            for i in 0..N {
-                let sc = self.ctl.atol[i] + self.ctl.rtol * y[i].abs();
-                d0 += (y[i] / sc).powi(2);
-                d1 += (self.k1[i] / sc).powi(2);
-            }
-            let (d0, d1) = ((d0 / N as f64).sqrt(), (d1 / N as f64).sqrt());
-            let h0 = if d0 < 1e-5 || d1 < 1e-5 {
-                1e-6
-            } else {
-                0.01 * d0 / d1
-            };
-            self.h = h0.min(sys.max_step()).max(self.ctl.h_min * 10.0);
+            self.h = initial_step(&self.ctl, y, &self.k1, sys.max_step());
         }
     }
 
@@ -194,7 +218,7 @@ impl<const N: usize> Dopri5<N> {
         k7: &[f64; N],
         k: &[[f64; N]; 4],
     ) {
-        let mut r = [[0.0; N]; 5];
+        let mut r = [[0.0; N]; 8];
         for i in 0..N {
             let ydiff = y_new[i] - y[i];
             let bspl = h * self.k1[i] - ydiff;
@@ -214,6 +238,7 @@ impl<const N: usize> Dopri5<N> {
             t0: t,
             h,
             t_end: t + h,
+            terms: 5,
             r,
             y1: *y_new,
         };
@@ -337,6 +362,36 @@ impl<const N: usize> Dopri5<N> {
         }
         let err = (acc / N as f64).sqrt();
         (y_new, k7, [k3, k4, k5, k6], err)
+    }
+}
+
+impl<const N: usize> Stepper<N> for Dopri5<N> {
+    fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
+        Dopri5::restart(self, sys, t, y)
+    }
+    fn step<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64; N],
+        h_cap: f64,
+    ) -> Result<&Dense<N>, SolveError> {
+        Dopri5::step(self, sys, t, y, h_cap)
+    }
+    fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
+        Dopri5::cut_last_step(self, t_cut)
+    }
+    fn last_dense(&self) -> &Dense<N> {
+        &self.dense
+    }
+    fn cap_next_step(&mut self, h_s: f64) {
+        Dopri5::cap_next_step(self, h_s)
+    }
+    fn stats(&self) -> Stats {
+        self.stats
+    }
+    fn count_event(&mut self) {
+        self.stats.events += 1;
     }
 }
 

@@ -7,9 +7,11 @@
 //! crosses to zero or below; it then returns *why* it stopped as a [`Stop`] and the caller
 //! switches mode and calls it again (the step restarts cleanly, without the FSAL stage).
 
+mod dop853;
 mod dopri5;
 mod events;
 
+pub use dop853::Dop853;
 pub use dopri5::{Dense, Dopri5, StepControl};
 pub use events::locate_crossing;
 
@@ -82,14 +84,39 @@ pub struct Stats {
     pub events: u64,
 }
 
+/// An adaptive one-step method with dense output, as [`integrate`] drives it.
+pub trait Stepper<const N: usize> {
+    /// Evaluates the derivative at `(t, y)` (a clean restart after a mode switch) and, on
+    /// the first call, picks an initial step.
+    fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]);
+    /// Takes one accepted step from `(t, y)` of at most `h_cap`, retrying rejected attempts.
+    fn step<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64; N],
+        h_cap: f64,
+    ) -> Result<&Dense<N>, SolveError>;
+    /// Cuts the last accepted step at `t_cut` (an event time inside it) and returns it.
+    fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N>;
+    /// The interpolant of the last accepted step.
+    fn last_dense(&self) -> &Dense<N>;
+    /// Caps the next step at `h_s` (after a mode switch).
+    fn cap_next_step(&mut self, h_s: f64);
+    /// Work counters, accumulated over every call.
+    fn stats(&self) -> Stats;
+    /// Counts one located event.
+    fn count_event(&mut self);
+}
+
 /// Integrates `sys` from `(t, y)` towards `t_end`, advancing `t` and `y` in place.
 ///
 /// The step stops exactly at `t_end`, at a located guard crossing, or where an observer
 /// breaks. `stepper` keeps its step-size history across calls; after an event the caller
 /// changes the system's mode, and the next call restarts the step from a fresh RHS value.
-pub fn integrate<S, O, const N: usize>(
+pub fn integrate<S, O, M, const N: usize>(
     sys: &S,
-    stepper: &mut Dopri5<N>,
+    stepper: &mut M,
     t: &mut f64,
     y: &mut [f64; N],
     t_end: f64,
@@ -98,6 +125,7 @@ pub fn integrate<S, O, const N: usize>(
 where
     S: OdeSystem<N>,
     O: Observer<S, N>,
+    M: Stepper<N>,
 {
     stepper.restart(sys, *t, y);
     let mut g0 = [0.0; MAX_GUARDS];
@@ -142,7 +170,7 @@ where
         }
         match first {
             Some((index, _lo, hi)) => {
-                stepper.stats.events += 1;
+                stepper.count_event();
                 let cut = stepper.cut_last_step(hi);
                 *t = hi;
                 *y = cut.y1();
