@@ -12,6 +12,7 @@ use whirlmap_sweep::classify::{ClassifyParams, OrbitClass};
 use whirlmap_sweep::critical::{
     check_mus, critical_speeds_with, CriticalOptions, CriticalResult, DEFAULT_SCAN_POINTS,
 };
+use whirlmap_sweep::recheck::{recheck_bracket, Recheck};
 
 #[derive(clap::Args)]
 pub struct CriticalArgs {
@@ -47,6 +48,10 @@ pub struct CriticalArgs {
     /// Print the results as JSON instead of tables.
     #[arg(long)]
     json: bool,
+    /// Fidelity preset (draft, standard, reference) for the search; the two bracket cells
+    /// are then re-checked at the next tighter preset (recorded as `recheck`).
+    #[arg(long)]
+    fidelity: Option<whirlmap_core::Fidelity>,
 }
 
 /// The JSON output: the search settings and one result per mu.
@@ -67,6 +72,8 @@ struct MuResult<'a> {
     mu: f64,
     #[serde(flatten)]
     result: &'a CriticalResult,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    recheck: Option<Recheck>,
 }
 
 /// Names a bad flag: `--from = -5: allowed ...`.
@@ -98,7 +105,10 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
     };
     opts.validate().map_err(flag_error)?;
     check_mus(&a.mu).map_err(flag_error)?;
-    let base = build_scene(a.scene.as_deref(), &a.set, None, None).map_err(Failure::Input)?;
+    let mut base = build_scene(a.scene.as_deref(), &a.set, None, None).map_err(Failure::Input)?;
+    if let Some(f) = a.fidelity {
+        f.apply(&mut base);
+    }
     // Each mu must make a valid scene (e.g. mu_static >= mu_dynamic) before anything runs.
     for &mu in &a.mu {
         let mut s = base.clone();
@@ -109,6 +119,19 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
 
     let start = Instant::now();
     let results = critical_speeds_with(&base, &a.mu, &opts);
+    let drop_opts = whirlmap_core::DropOptions {
+        duration_s: a.duration_s,
+        ..Default::default()
+    };
+    let rechecks: Vec<Option<Recheck>> = results
+        .iter()
+        .map(|(mu, r)| {
+            let tighter = a.fidelity.and_then(|f| f.tighter())?;
+            let mut s = base.clone();
+            s.mu_dynamic = *mu;
+            recheck_bracket(&s, r, tighter, &drop_opts, &ClassifyParams::default())
+        })
+        .collect();
     let wall_s = start.elapsed().as_secs_f64();
 
     if a.json {
@@ -122,7 +145,12 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
             model_version: MODEL_VERSION,
             results: results
                 .iter()
-                .map(|(mu, result)| MuResult { mu: *mu, result })
+                .zip(&rechecks)
+                .map(|((mu, result), recheck)| MuResult {
+                    mu: *mu,
+                    result,
+                    recheck: recheck.clone(),
+                })
                 .collect(),
         };
         println!(
@@ -137,7 +165,7 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
         a.from, a.to, a.scan_points, a.tol_rpm, a.duration_s
     );
     let class = |c: Option<OrbitClass>| c.map_or("-", |c| c.name());
-    for (mu, r) in &results {
+    for ((mu, r), recheck) in results.iter().zip(&rechecks) {
         println!();
         println!("  mu_d = {mu}");
         match r.bracket {
@@ -168,8 +196,28 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
             if r.non_monotone { "YES" } else { "no" }
         );
         println!("    note                {}", r.note);
+        if let Some(rc) = recheck {
+            let show = |o: &whirlmap_sweep::critical::Outcome| match o {
+                whirlmap_sweep::critical::Outcome::Class(c) => c.name().to_string(),
+                whirlmap_sweep::critical::Outcome::Failed(e) => format!("failed ({e})"),
+            };
+            println!(
+                "    recheck ({})   {:.1}: {}, {:.1}: {} -> {}",
+                rc.fidelity,
+                rc.lo.0,
+                show(&rc.lo.1),
+                rc.hi.0,
+                show(&rc.hi.1),
+                if rc.confirmed {
+                    "bracket confirmed"
+                } else {
+                    "NOT confirmed"
+                }
+            );
+        }
     }
-    let drops: usize = results.iter().map(|(_, r)| r.drops_used).sum();
+    let drops: usize = results.iter().map(|(_, r)| r.drops_used).sum::<usize>()
+        + 2 * rechecks.iter().flatten().count();
     println!();
     println!("  {drops} drops, {wall_s:.2} s wall");
     Ok(())

@@ -15,6 +15,7 @@ use whirlmap_sweep::overrides::apply_assignment;
 use whirlmap_sweep::record::DropRecord;
 use whirlmap_sweep::render::{draw_orbit, ImageFormat};
 
+mod accuracy_cmd;
 mod bench;
 mod critical_cmd;
 mod render_cmd;
@@ -46,6 +47,9 @@ enum Command {
     Critical(critical_cmd::CriticalArgs),
     /// Run a grid of drops from a JSON sweep spec (exit 1 if any point failed).
     Sweep(sweep_cmd::SweepArgs),
+    /// Work-precision study: representative drops at a ladder of tolerances and model
+    /// settings against a DOP853 reference (CSV, Markdown, log-log charts).
+    Accuracy(accuracy_cmd::AccuracyArgs),
 }
 
 #[derive(clap::Args)]
@@ -71,6 +75,10 @@ struct DropArgs {
     /// Draw the orbit (Fig. 3 view) to this .png or .svg file.
     #[arg(long)]
     orbit: Option<PathBuf>,
+    /// Fidelity preset (draft, standard, reference): sets the tolerance, the integrator and
+    /// the reduced model last, over the scene file and --set. Default: the scene's settings.
+    #[arg(long)]
+    fidelity: Option<whirlmap_core::Fidelity>,
 }
 
 /// A failure with its exit code.
@@ -125,8 +133,11 @@ fn build_scene(
 }
 
 fn run_drop(a: &DropArgs) -> Result<(), Failure> {
-    let scene =
+    let mut scene =
         build_scene(a.scene.as_deref(), &a.set, a.speed_rpm, a.mu).map_err(Failure::Input)?;
+    if let Some(f) = a.fidelity {
+        f.apply(&mut scene);
+    }
     if let Some(p) = &a.orbit {
         ImageFormat::from_path(p).map_err(|e| Failure::Input(e.into()))?;
     }
@@ -225,6 +236,7 @@ fn main() -> ExitCode {
         }),
         Command::Critical(a) => critical_cmd::run(a),
         Command::Sweep(a) => return sweep_cmd::run(a),
+        Command::Accuracy(a) => accuracy_cmd::run_cmd(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -42,6 +42,7 @@
 
 pub mod drop;
 pub mod error;
+pub mod fidelity;
 pub mod model;
 pub mod monitor;
 pub mod ode;
@@ -52,5 +53,6 @@ pub use drop::{
     simulate, simulate_observed, DropOptions, DropReport, EnergyAudit, StopReason, MODEL_VERSION,
 };
 pub use error::{InvalidParameter, SolveError};
+pub use fidelity::Fidelity;
 pub use monitor::{Features, Window};
 pub use scene::{FrictionLaw, Method, Scene, SolverSettings};

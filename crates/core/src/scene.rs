@@ -319,7 +319,9 @@ impl Scene {
         check(
             "unbalance_m",
             self.unbalance_m,
-            self.unbalance_m >= 0.0 && self.unbalance_m <= 10.0 * self.clearance_m,
+            // Relative slack of 1e-12: 10 * 1e-6 rounds below 1e-5, which rejected a
+            // user's exact "unbalance = 10 clearances" (found by the extremes matrix).
+            self.unbalance_m >= 0.0 && self.unbalance_m <= 10.0 * self.clearance_m * (1.0 + 1e-12),
             "[0, 10 * clearance_m] m",
         )?;
         check(

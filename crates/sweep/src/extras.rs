@@ -63,7 +63,7 @@ pub fn run_critical(spec: &SweepSpec, out_dir: &Path) -> Result<Option<PathBuf>,
         return Ok(None);
     };
     let results = critical_speeds(
-        &spec.scene,
+        &spec.base_scene(),
         &c.mu,
         c.speed_rpm.from,
         c.speed_rpm.to,
@@ -114,7 +114,7 @@ pub fn record_orbits(spec: &SweepSpec, out_dir: &Path) -> Result<Vec<PathBuf>, E
     let runs: Vec<_> = mus
         .par_iter()
         .map(|&mu| {
-            let mut scene = spec.scene.clone();
+            let mut scene = spec.base_scene();
             scene.speed_rpm = speed;
             scene.mu_dynamic = mu;
             let opts = DropOptions {

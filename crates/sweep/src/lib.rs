@@ -7,14 +7,19 @@
 //! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
 //!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
+//! - [`accuracy`] and [`accuracy_chart`]: the work-precision study (`whirlmap accuracy`).
 #![warn(missing_docs)]
 
+pub mod accuracy;
+pub mod accuracy_chart;
 pub mod charts;
 pub mod classify;
 pub mod critical;
 pub mod extras;
+pub mod extremes;
 pub mod fonts;
 pub mod overrides;
+pub mod recheck;
 pub mod record;
 pub mod render;
 pub mod spec;

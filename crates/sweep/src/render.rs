@@ -273,16 +273,16 @@ pub(crate) const X_LABEL_AREA: u32 = 58;
 pub(crate) const Y_LABEL_AREA: u32 = 82;
 
 const TEXT_COLOUR: RGBColor = RGBColor(30, 30, 30);
-const AXIS_COLOUR: RGBColor = RGBColor(90, 90, 90);
-const GRID_BOLD: RGBColor = RGBColor(212, 212, 212);
-const GRID_LIGHT: RGBColor = RGBColor(236, 236, 236);
+pub(crate) const AXIS_COLOUR: RGBColor = RGBColor(90, 90, 90);
+pub(crate) const GRID_BOLD: RGBColor = RGBColor(212, 212, 212);
+pub(crate) const GRID_LIGHT: RGBColor = RGBColor(236, 236, 236);
 pub(crate) const PATH_COLOUR: RGBColor = RGBColor(31, 119, 180);
 const FORCE_COLOUR: RGBColor = RGBColor(190, 50, 40);
 pub(crate) const CLEARANCE_COLOUR: RGBColor = RGBColor(120, 120, 120);
 const START_COLOUR: RGBColor = RGBColor(44, 160, 44);
 const END_COLOUR: RGBColor = RGBColor(214, 39, 40);
 
-fn text_style(size: f64) -> TextStyle<'static> {
+pub(crate) fn text_style(size: f64) -> TextStyle<'static> {
     TextStyle::from((FONT_FAMILY, size).into_font()).color(&TEXT_COLOUR)
 }
 
@@ -305,7 +305,7 @@ fn draw_centered_text<DB: DrawingBackend>(
 
 /// Splits off a band of `height` px at the top of `area` with `text` centred in it; returns
 /// the rest.
-fn with_header<DB: DrawingBackend>(
+pub(crate) fn with_header<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     height: u32,
     text: &str,
@@ -318,14 +318,17 @@ fn with_header<DB: DrawingBackend>(
 
 /// How a legend entry is marked.
 #[derive(Clone, Copy)]
-enum LegendMark {
+pub(crate) enum LegendMark {
+    /// A solid line.
     Line(RGBColor),
+    /// A dashed line.
     Dashed(RGBColor),
+    /// A filled dot.
     Dot(RGBColor),
 }
 
 /// Draws a one-row legend centred in `area` (outside the plot, so it never hides data).
-fn draw_legend_row<DB: DrawingBackend>(
+pub(crate) fn draw_legend_row<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[(LegendMark, &str)],
 ) -> DrawResult<DB> {

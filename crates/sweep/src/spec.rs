@@ -16,6 +16,8 @@
 //!   row-major: the first axis varies slowest, the last fastest.
 //! - `critical` (optional): the critical-speed search ([`CriticalSpec`]).
 //! - `charts` (optional): chart names out of [`CHART_NAMES`].
+//! - `fidelity` (optional): a preset, `draft`, `standard` or `reference`
+//!   ([`whirlmap_core::Fidelity`]), applied to the base scene before the axes.
 //!
 //! Everything is checked by [`load`] before any drop runs; every error names the field and
 //! the value. Parse errors carry the file path, line and column.
@@ -28,7 +30,7 @@ use serde_json::Value;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
-use whirlmap_core::{InvalidParameter, Scene};
+use whirlmap_core::{Fidelity, InvalidParameter, Scene};
 
 /// Chart names a spec may list.
 pub const CHART_NAMES: &[&str] = &["orbits", "critical", "max_force", "peak_power", "classes"];
@@ -341,6 +343,22 @@ pub struct SweepSpec {
     /// the values of the `mu` axis (at most eight).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orbits: Option<OrbitsSpec>,
+    /// Fidelity preset (`draft`, `standard`, `reference`) applied to the base scene before
+    /// the axes (so an axis may still vary `solver.rtol`); absent: the scene's own settings,
+    /// as every earlier sweep ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fidelity: Option<Fidelity>,
+}
+
+impl SweepSpec {
+    /// The base scene with the fidelity preset, if any, applied: what every drop of the
+    /// sweep, its critical search and its orbits start from.
+    pub fn base_scene(&self) -> Scene {
+        match self.fidelity {
+            Some(f) => f.applied(&self.scene),
+            None => self.scene.clone(),
+        }
+    }
 }
 
 /// The Fig. 3 panels: one drop per friction coefficient at one speed, orbit recorded.
@@ -491,7 +509,7 @@ impl SweepSpec {
             }
             // Unknown names and values of the wrong type, checked on the base scene.
             for v in &values {
-                let mut s = self.scene.clone();
+                let mut s = self.base_scene();
                 overrides::apply(&mut s, key, axis_json(*v)).map_err(|source| SpecError::Axis {
                     axis: axis.name.clone(),
                     source,
@@ -579,7 +597,7 @@ impl SweepSpec {
         let mut points = Vec::with_capacity(total);
         let mut idx = vec![0usize; axes.len()];
         for index in 0..total {
-            let mut scene = self.scene.clone();
+            let mut scene = self.base_scene();
             let mut inputs = Vec::with_capacity(axes.len());
             for (k, (axis, values)) in axes.iter().enumerate() {
                 let v = values[idx[k]];
@@ -652,6 +670,18 @@ mod tests {
 
     fn err(f: impl FnOnce(&mut Value)) -> String {
         with(f).expect_err("should be rejected")
+    }
+
+    #[test]
+    fn a_fidelity_preset_sets_the_base_scene_and_a_bad_one_is_named() {
+        let spec = with(|v| v["fidelity"] = "draft".into()).unwrap();
+        let p = &spec.points().unwrap()[0];
+        assert!(p.scene.quasi_static_race);
+        assert_eq!(p.scene.solver.rtol, Fidelity::Draft.rtol());
+        let plain = with(|_| {}).unwrap();
+        assert_eq!(plain.points().unwrap()[0].scene.solver.rtol, 1e-6);
+        let e = err(|v| v["fidelity"] = "fast".into());
+        assert!(e.contains("fast") && e.contains("draft"), "{e}");
     }
 
     #[test]

@@ -1,0 +1,50 @@
+//! Re-checking a critical-speed bracket at a tighter fidelity preset.
+//!
+//! A search run at a cheap preset (say `draft`) brackets the whirl boundary with two drops.
+//! Those two cells decide the answer, so they are run again at the next tighter preset; the
+//! result says whether the tighter model agrees (non-whirl below, whirl above) and is
+//! recorded next to the bracket.
+
+use crate::classify::ClassifyParams;
+use crate::critical::{drop_outcome, CriticalResult, Outcome};
+use serde::{Deserialize, Serialize};
+use whirlmap_core::{DropOptions, Fidelity, Scene};
+
+/// The bracket cells run again at a tighter preset.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Recheck {
+    /// The preset the cells were re-run at.
+    pub fidelity: Fidelity,
+    /// Lower bracket speed (r/min) and its outcome at that preset.
+    pub lo: (f64, Outcome),
+    /// Upper bracket speed (r/min) and its outcome at that preset.
+    pub hi: (f64, Outcome),
+    /// True when the tighter preset also gives no whirl at `lo` and whirl at `hi`.
+    pub confirmed: bool,
+}
+
+/// Re-runs the bracket of `result` (searched on `scene`, whose `mu_dynamic` is set) at
+/// `tighter`; `None` without a bracket.
+pub fn recheck_bracket(
+    scene: &Scene,
+    result: &CriticalResult,
+    tighter: Fidelity,
+    opts: &DropOptions,
+    params: &ClassifyParams,
+) -> Option<Recheck> {
+    let (lo, hi) = result.bracket?;
+    let s = tighter.applied(scene);
+    let out_lo = drop_outcome(&s, lo, opts, params);
+    let out_hi = drop_outcome(&s, hi, opts, params);
+    let whirl = |o: &Outcome| match o {
+        Outcome::Class(c) => Some(c.is_whirl()),
+        Outcome::Failed(_) => None,
+    };
+    let confirmed = whirl(&out_lo) == Some(false) && whirl(&out_hi) == Some(true);
+    Some(Recheck {
+        fidelity: tighter,
+        lo: (lo, out_lo),
+        hi: (hi, out_hi),
+        confirmed,
+    })
+}

@@ -1,0 +1,80 @@
+//! `whirlmap accuracy`: the work-precision study (cases x settings x tolerances against a
+//! DOP853 reference), written as CSV, Markdown and log-log charts.
+//!
+//! Exit codes: 0 done (failed ladder runs are rows, not errors); 2 bad case file; 3 a
+//! reference run failed; 4 an output could not be written.
+
+use crate::Failure;
+use anyhow::Context;
+use std::path::PathBuf;
+use whirlmap_sweep::accuracy::{run, to_csv, to_markdown, AccuracySpec, AccuracySpecError};
+use whirlmap_sweep::accuracy_chart::{draw_work_precision, CostAxis};
+
+/// Arguments of `whirlmap accuracy`.
+#[derive(clap::Args)]
+pub struct AccuracyArgs {
+    /// Case file (JSON): cases, tolerance ladder, settings.
+    #[arg(long, default_value = "sweeps/accuracy-cases.json")]
+    cases: PathBuf,
+    /// Output folder.
+    #[arg(long, default_value = "results/accuracy")]
+    out: PathBuf,
+    /// Worker threads (1 gives the cleanest wall times); default 1.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    threads: u32,
+}
+
+/// Runs the study and writes `accuracy.csv`, `accuracy.md`, `study.json` and the charts.
+pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
+    let spec = AccuracySpec::load(&a.cases).map_err(|e| Failure::Input(e.into()))?;
+    std::fs::create_dir_all(&a.out)
+        .with_context(|| format!("cannot create {}", a.out.display()))
+        .map_err(Failure::Output)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(a.threads as usize)
+        .build()
+        .map_err(|e| Failure::Input(e.into()))?;
+    let jobs = spec.cases.len()
+        * (2 + 3
+            + spec
+                .settings
+                .iter()
+                .map(|s| s.rtol.as_ref().unwrap_or(&spec.rtol).len())
+                .sum::<usize>());
+    eprintln!(
+        "whirlmap accuracy: {} cases, {} settings, {jobs} drops on {} thread(s)",
+        spec.cases.len(),
+        spec.settings.len(),
+        a.threads
+    );
+    let study = pool.install(|| run(&spec)).map_err(|e| match e {
+        AccuracySpecError::Range { ref field, .. } if field == "cases" => Failure::Solve(e.into()),
+        e => Failure::Input(e.into()),
+    })?;
+    let write = |name: &str, text: String| {
+        let p = a.out.join(name);
+        std::fs::write(&p, text)
+            .with_context(|| format!("cannot write {}", p.display()))
+            .map_err(Failure::Output)
+    };
+    write("accuracy.csv", to_csv(&study))?;
+    let md = to_markdown(&study, &spec);
+    write("accuracy.md", md.clone())?;
+    write(
+        "study.json",
+        serde_json::to_string_pretty(&study).expect("a study serialises"),
+    )?;
+    for (axis, stem) in [
+        (CostAxis::RhsEvals, "work_precision"),
+        (CostAxis::WallMs, "work_precision_wall"),
+    ] {
+        for ext in ["png", "svg"] {
+            let p = a.out.join(format!("{stem}.{ext}"));
+            let title = format!("Work-precision: {} (reference DOP853)", spec.name);
+            draw_work_precision(&p, &study, axis, &title).map_err(|e| Failure::Output(e.into()))?;
+        }
+    }
+    println!("{md}");
+    eprintln!("written to {}", a.out.display());
+    Ok(())
+}
