@@ -16,6 +16,10 @@
 //! event location and the observers are shared. Agreement of the two at tight tolerance
 //! therefore confirms the integration, which is what a reference needs.
 
+// The coefficients are kept to the 30 digits of the published tableau, so they can be checked
+// against it digit by digit; f64 rounds them.
+#![allow(clippy::excessive_precision)]
+
 use super::dopri5::{initial_step, Dense, StepControl};
 use super::{OdeSystem, Stats, Stepper};
 use crate::error::SolveError;

@@ -1,0 +1,96 @@
+//! End-to-end tests of the fidelity presets and the `accuracy` command.
+
+use std::process::{Command, Output};
+
+fn whirlmap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_whirlmap"))
+        .args(args)
+        .output()
+        .expect("runs the binary")
+}
+
+fn record(args: &[&str]) -> serde_json::Value {
+    let out = whirlmap(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
+
+#[test]
+fn draft_is_cheaper_and_close_on_the_first_impact_and_a_bad_preset_exits_2() {
+    let base = ["drop", "--duration-s", "0.02", "--json"];
+    let plain = record(&base);
+    let standard = record(&[&base[..], &["--fidelity", "standard"]].concat());
+    let draft = record(&[&base[..], &["--fidelity", "draft"]].concat());
+    // `standard` is the scene default: the very same record.
+    assert_eq!(plain, standard);
+    let evals = |v: &serde_json::Value| v["stats"]["rhs_evals"].as_u64().unwrap();
+    assert!(
+        evals(&draft) < evals(&standard),
+        "{} vs {}",
+        evals(&draft),
+        evals(&standard)
+    );
+    // The massless race raises the first impact by about the race/rotor mass ratio (0.8 %).
+    let f = |v: &serde_json::Value| v["first_contact_force_n"].as_f64().unwrap();
+    let rel = (f(&draft) - f(&standard)) / f(&standard);
+    assert!(rel > 0.0 && rel < 0.03, "draft first impact off by {rel}");
+
+    let out = whirlmap(&["drop", "--fidelity", "fast"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("fast") && err.contains("draft, standard, reference"),
+        "{err}"
+    );
+}
+
+#[test]
+fn accuracy_writes_its_table_and_charts() {
+    let dir = std::env::temp_dir().join(format!("whirlmap-acc-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases = dir.join("cases.json");
+    std::fs::write(
+        &cases,
+        r#"{"name": "t", "duration_s": 0.01, "reference_rtol": 1e-8, "rtol": [1e-4],
+            "cases": [{"name": "pendulum", "scene": {"mu_dynamic": 0.1}}],
+            "settings": [{"name": "full"}]}"#,
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = whirlmap(&[
+        "accuracy",
+        "--cases",
+        cases.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "accuracy.csv",
+        "accuracy.md",
+        "work_precision.png",
+        "work_precision.svg",
+    ] {
+        assert!(out_dir.join(f).exists(), "{f} missing");
+    }
+    let csv = std::fs::read_to_string(out_dir.join("accuracy.csv")).unwrap();
+    // One ladder row and three preset rows, each ok.
+    assert_eq!(
+        csv.lines().filter(|l| l.contains(",ok,")).count(),
+        4,
+        "{csv}"
+    );
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, r#"{"rtol": [0.5], "cases": [], "settings": []}"#).unwrap();
+    let out = whirlmap(&["accuracy", "--cases", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}
