@@ -17,7 +17,9 @@ use whirlmap_sweep::render::{draw_orbit, ImageFormat};
 
 mod bench;
 mod critical_cmd;
+mod merge_cmd;
 mod render_cmd;
+mod shard_cmd;
 mod sweep_cmd;
 
 #[derive(Parser)]
@@ -46,6 +48,9 @@ enum Command {
     Critical(critical_cmd::CriticalArgs),
     /// Run a grid of drops from a JSON sweep spec (exit 1 if any point failed).
     Sweep(sweep_cmd::SweepArgs),
+    /// Join the shard folders of a sweep into one result (exit 2 if a point is missing or
+    /// twice, or the shards differ in spec or model version; 1 if any point failed).
+    Merge(merge_cmd::MergeArgs),
 }
 
 #[derive(clap::Args)]
@@ -225,6 +230,7 @@ fn main() -> ExitCode {
         }),
         Command::Critical(a) => critical_cmd::run(a),
         Command::Sweep(a) => return sweep_cmd::run(a),
+        Command::Merge(a) => return merge_cmd::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

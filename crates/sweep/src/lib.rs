@@ -6,6 +6,7 @@
 //! - [`render`] and [`fonts`]: charts with an embedded font (no system fonts needed).
 //! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
 //!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
+//! - [`shard`] and [`merge`]: a sweep split over machines and joined again.
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
 #![warn(missing_docs)]
 
@@ -14,8 +15,10 @@ pub mod classify;
 pub mod critical;
 pub mod extras;
 pub mod fonts;
+pub mod merge;
 pub mod overrides;
 pub mod record;
 pub mod render;
+pub mod shard;
 pub mod spec;
 pub mod sweep;
