@@ -7,11 +7,13 @@
 //! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
 //!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
 //! - [`shard`] and [`merge`]: a sweep split over machines and joined again.
+//! - [`compare`]: what changed between two results (nightly jobs).
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
 #![warn(missing_docs)]
 
 pub mod charts;
 pub mod classify;
+pub mod compare;
 pub mod critical;
 pub mod extras;
 pub mod fonts;
