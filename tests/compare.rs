@@ -159,3 +159,25 @@ fn compare_exit_codes_thresholds_and_report() {
     assert!(out(&o).contains("--force-rel"), "{}", out(&o));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The nightly example end to end: `scripts/nightly.sh` runs `sweeps/nightly.json` and finds
+/// it the same as the committed `results/nightly-baseline/` (exit 0), with its report.
+#[test]
+fn nightly_script_reproduces_the_committed_baseline() {
+    let dir = temp_dir("nightly");
+    let run = dir.join("run");
+    let o = Command::new("bash")
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/nightly.sh"))
+        .arg(&run)
+        .env("WHIRLMAP", BIN)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", out(&o));
+    assert!(out(&o).contains("nightly: the same as results/nightly-baseline"));
+    let md = std::fs::read_to_string(run.join("compare.md")).unwrap();
+    assert!(
+        md.contains("**SAME**: 0 of 20 points and 0 of 3 critical speeds"),
+        "{md}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

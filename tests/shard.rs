@@ -269,7 +269,7 @@ fn merge_refuses_missing_duplicated_and_mismatched_shards() {
     refused(&mixed, &["different model versions"]);
     // Not a shard folder.
     refused(
-        &[dir.clone()],
+        std::slice::from_ref(&dir),
         &["shard.json", "not a shard's output folder"],
     );
     // A record that is not of this spec's grid.
@@ -280,7 +280,7 @@ fn merge_refuses_missing_duplicated_and_mismatched_shards() {
     }
     let mut lines = std::fs::read_to_string(shards[3].join("points.jsonl")).unwrap();
     lines.push_str(
-        &std::fs::read_to_string(other_dir.join("s2/points.jsonl"))
+        std::fs::read_to_string(other_dir.join("s2/points.jsonl"))
             .unwrap()
             .lines()
             .next()
