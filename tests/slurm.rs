@@ -305,6 +305,52 @@ impl Drop for Cluster {
     }
 }
 
+/// Only one run of this test at a time on a machine (two `cargo test` runs, e.g. in two
+/// checkouts, would share the ports and the folder): a lock file holding the owner's PID,
+/// taken over when that process is gone, removed on drop.
+struct MachineLock(PathBuf);
+
+impl MachineLock {
+    fn take() -> MachineLock {
+        let path = std::env::temp_dir().join("whirlmap-slurm-test.lock");
+        let start = Instant::now();
+        loop {
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&path)
+            {
+                Ok(mut f) => {
+                    use std::io::Write;
+                    write!(f, "{}", std::process::id()).unwrap();
+                    return MachineLock(path);
+                }
+                Err(_) => {
+                    let owner = std::fs::read_to_string(&path).unwrap_or_default();
+                    let alive =
+                        !owner.trim().is_empty() && Path::new("/proc").join(owner.trim()).exists();
+                    if !alive {
+                        let _ = std::fs::remove_file(&path);
+                        continue;
+                    }
+                    assert!(
+                        start.elapsed() < QUEUE_TIMEOUT,
+                        "another run of this test (pid {owner}) holds {}",
+                        path.display()
+                    );
+                    std::thread::sleep(Duration::from_millis(500));
+                }
+            }
+        }
+    }
+}
+
+impl Drop for MachineLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
@@ -345,6 +391,7 @@ fn slurm_job_array_shards_merge_to_the_local_run() {
         "the Slurm test needs root to install and start slurmctld/slurmd/munged; run as root \
          or set WHIRLMAP_SKIP_SLURM=1 to skip it"
     );
+    let _lock = MachineLock::take();
     install();
     let before = slurm_processes();
     let dir = std::env::temp_dir().join("whirlmap-slurm-test");
