@@ -17,8 +17,11 @@ use whirlmap_sweep::render::{draw_orbit, ImageFormat};
 
 mod accuracy_cmd;
 mod bench;
+mod compare_cmd;
 mod critical_cmd;
+mod merge_cmd;
 mod render_cmd;
+mod shard_cmd;
 mod sweep_cmd;
 
 #[derive(Parser)]
@@ -50,6 +53,13 @@ enum Command {
     /// Work-precision study: representative drops at a ladder of tolerances and model
     /// settings against a DOP853 reference (CSV, Markdown, log-log charts).
     Accuracy(accuracy_cmd::AccuracyArgs),
+    /// Join the shard folders of a sweep into one result (exit 2 if a point is missing or
+    /// twice, or the shards differ in spec or model version; 1 if any point failed).
+    Merge(merge_cmd::MergeArgs),
+    /// Compare two sweep results: class changes, force and power changes beyond thresholds,
+    /// critical-speed shifts; a Markdown report with a class map (exit 0 same, 1 changed,
+    /// 2 error).
+    Compare(compare_cmd::CompareArgs),
 }
 
 #[derive(clap::Args)]
@@ -237,6 +247,8 @@ fn main() -> ExitCode {
         Command::Critical(a) => critical_cmd::run(a),
         Command::Sweep(a) => return sweep_cmd::run(a),
         Command::Accuracy(a) => accuracy_cmd::run_cmd(a),
+        Command::Merge(a) => return merge_cmd::run(a),
+        Command::Compare(a) => return compare_cmd::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

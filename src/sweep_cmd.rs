@@ -13,19 +13,27 @@ use whirlmap_sweep::sweep::{run_sweep, ProgressMode, RunOptions, SweepError};
 #[derive(clap::Args)]
 pub struct SweepArgs {
     /// Sweep spec (JSON): name, scene overrides, duration_s, axes, optional critical, charts.
-    file: PathBuf,
+    pub(crate) file: PathBuf,
     /// Output folder; default `results/<name>`.
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub(crate) out: Option<PathBuf>,
     /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    threads: Option<u32>,
+    pub(crate) threads: Option<u32>,
     /// Keep the ok points of an existing points.jsonl and run only the rest.
     #[arg(long)]
-    resume: bool,
+    pub(crate) resume: bool,
     /// No progress bar or progress lines.
     #[arg(long)]
-    no_progress: bool,
+    pub(crate) no_progress: bool,
+    /// Run only shard I of --shards N (0 <= I < N): grid points, critical searches and orbit
+    /// panels whose position mod N is I; default --out results/<name>/shard-I-of-N. Join the
+    /// shards with `whirlmap merge`.
+    #[arg(long, requires = "shards", value_name = "I")]
+    shard: Option<usize>,
+    /// The number of shards (see --shard).
+    #[arg(long, requires = "shard", value_name = "N")]
+    shards: Option<usize>,
 }
 
 /// Runs the subcommand and returns the process exit code.
@@ -37,6 +45,9 @@ pub fn run(a: &SweepArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let (Some(i), Some(n)) = (a.shard, a.shards) {
+        return crate::shard_cmd::run(a, &spec, i, n);
+    }
     let out_dir = a
         .out
         .clone()

@@ -715,17 +715,19 @@ enum CellKind {
 
 /// What the grid charts draw per cell.
 #[derive(Clone, Copy)]
-enum GridMode {
+enum GridMode<'a> {
     /// A metric in a colour scale, whirl left out.
     Metric(fn(&PointRow) -> Option<f64>),
     /// The class colour.
     Classes,
+    /// The class colour, the cells `(speed index, friction index)` outlined (`compare`).
+    MarkedClasses(&'a [(usize, usize)]),
 }
 
 struct GridFigure<'a> {
     grid: &'a Grid,
     title: String,
-    mode: GridMode,
+    mode: GridMode<'a>,
     bar_label: &'static str,
 }
 
@@ -741,7 +743,7 @@ impl GridFigure<'_> {
             return CellKind::NoValue;
         };
         match self.mode {
-            GridMode::Classes => CellKind::Class(class),
+            GridMode::Classes | GridMode::MarkedClasses(_) => CellKind::Class(class),
             GridMode::Metric(_) if class.is_whirl() => CellKind::Whirl(class),
             GridMode::Metric(f) => {
                 f(row).map_or(CellKind::NoValue, |v| CellKind::Value(clamp_value(v)))
@@ -845,6 +847,18 @@ impl Figure for GridFigure<'_> {
             }
         }
 
+        if let GridMode::MarkedClasses(marked) = self.mode {
+            for &(i, j) in marked.iter().filter(|(i, j)| *i < nx && *j < ny) {
+                let (tl, br) = (px(xe[i], ye[j + 1]), px(xe[i + 1], ye[j]));
+                for k in 2..6 {
+                    canvas.draw(&Rectangle::new(
+                        [(tl.0 + k, tl.1 + k), (br.0 - k, br.1 - k)],
+                        BLACK.stroke_width(1),
+                    ))?;
+                }
+            }
+        }
+
         let mut levels = Vec::new();
         if let (GridMode::Metric(_), Some((lo, hi))) = (self.mode, scale) {
             if values.len() >= 2 {
@@ -903,7 +917,10 @@ impl Figure for GridFigure<'_> {
         // Legend.
         let mut entries: Vec<(Mark, String)> = Vec::new();
         match self.mode {
-            GridMode::Classes => {
+            GridMode::Classes | GridMode::MarkedClasses(_) => {
+                if matches!(self.mode, GridMode::MarkedClasses(_)) {
+                    entries.push((Mark::Line(BLACK), "changed".to_string()));
+                }
                 let present: Vec<OrbitClass> = ALL_CLASSES.to_vec();
                 for c in present {
                     entries.push((Mark::Swatch(class_colour(c)), c.label().to_string()));
@@ -1437,6 +1454,25 @@ fn write_both<F: Figure>(
         render(&path, size, figure)?;
         written.push(path);
     }
+    Ok(())
+}
+
+/// Draws the class map of `grid` to `path` (PNG or SVG by extension) with the cells
+/// `marked` (speed index, friction index into the grid's axes) outlined in black: the changed
+/// cells of a comparison ([`crate::compare`]).
+pub fn draw_marked_class_map(
+    path: &Path,
+    grid: &Grid,
+    title: &str,
+    marked: &[(usize, usize)],
+) -> Result<(), ChartError> {
+    let figure = GridFigure {
+        grid,
+        title: with_slice(title, &grid.slice),
+        mode: GridMode::MarkedClasses(marked),
+        bar_label: "",
+    };
+    render(path, CHART_SIZE, &figure)?;
     Ok(())
 }
 

@@ -44,8 +44,23 @@ pub fn run_all(
     out_dir: &Path,
     threads: Option<usize>,
 ) -> Result<(Option<PathBuf>, Vec<PathBuf>), ExtrasError> {
+    run_all_owned(spec, out_dir, threads, |_| true)
+}
+
+/// [`run_all`] for a shard's part: the critical searches at positions `j` of `critical.mu`
+/// and the orbit panels at positions `i` for which `owns` is true.
+#[allow(clippy::type_complexity)]
+pub fn run_all_owned(
+    spec: &SweepSpec,
+    out_dir: &Path,
+    threads: Option<usize>,
+    owns: impl Fn(usize) -> bool + Sync,
+) -> Result<(Option<PathBuf>, Vec<PathBuf>), ExtrasError> {
     let work = || -> Result<_, ExtrasError> {
-        Ok((run_critical(spec, out_dir)?, record_orbits(spec, out_dir)?))
+        Ok((
+            run_critical_owned(spec, out_dir, &owns)?,
+            record_orbits_owned(spec, out_dir, &owns)?,
+        ))
     };
     match threads {
         Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
@@ -59,12 +74,26 @@ pub fn run_all(
 /// Runs the spec's `critical` section, if any, and writes `critical.json`: an array of
 /// `{"mu", "result"}` in the order of `critical.mu`. Returns the file written.
 pub fn run_critical(spec: &SweepSpec, out_dir: &Path) -> Result<Option<PathBuf>, ExtrasError> {
+    run_critical_owned(spec, out_dir, |_| true)
+}
+
+/// [`run_critical`] for the friction coefficients whose position `j` in `critical.mu`
+/// satisfies `owns(j)` (a shard's part; see [`crate::shard`]), in that order.
+pub fn run_critical_owned(
+    spec: &SweepSpec,
+    out_dir: &Path,
+    owns: impl Fn(usize) -> bool,
+) -> Result<Option<PathBuf>, ExtrasError> {
     let Some(c) = &spec.critical else {
         return Ok(None);
     };
+    let mus: Vec<f64> = (c.mu.iter().enumerate())
+        .filter(|(j, _)| owns(*j))
+        .map(|(_, mu)| *mu)
+        .collect();
     let results = critical_speeds(
         &spec.base_scene(),
-        &c.mu,
+        &mus,
         c.speed_rpm.from,
         c.speed_rpm.to,
         c.tol_rpm,
@@ -108,12 +137,28 @@ pub fn orbit_panels(spec: &SweepSpec) -> Option<(f64, Vec<f64>)> {
 /// `orbits/NN_speed_mu.json` files `{"speed_rpm", "mu", "class", "orbit"}`; a drop that fails
 /// is skipped with its error in `orbits/NN_speed_mu.error.txt`. Returns the files written.
 pub fn record_orbits(spec: &SweepSpec, out_dir: &Path) -> Result<Vec<PathBuf>, ExtrasError> {
+    record_orbits_owned(spec, out_dir, |_| true)
+}
+
+/// [`record_orbits`] for the panels whose position `i` satisfies `owns(i)` (a shard's part;
+/// see [`crate::shard`]); file names keep the panel's position.
+pub fn record_orbits_owned(
+    spec: &SweepSpec,
+    out_dir: &Path,
+    owns: impl Fn(usize) -> bool,
+) -> Result<Vec<PathBuf>, ExtrasError> {
     let Some((speed, mus)) = orbit_panels(spec) else {
         return Ok(Vec::new());
     };
-    let runs: Vec<_> = mus
+    let panels: Vec<(usize, f64)> = mus
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|(i, _)| owns(*i))
+        .collect();
+    let runs: Vec<_> = panels
         .par_iter()
-        .map(|&mu| {
+        .map(|&(i, mu)| {
             let mut scene = spec.base_scene();
             scene.speed_rpm = speed;
             scene.mu_dynamic = mu;
@@ -122,11 +167,11 @@ pub fn record_orbits(spec: &SweepSpec, out_dir: &Path) -> Result<Vec<PathBuf>, E
                 orbit_points: Some(20_000),
                 ..Default::default()
             };
-            (mu, simulate(&scene, &opts))
+            (i, mu, simulate(&scene, &opts))
         })
         .collect();
     let mut written = Vec::new();
-    for (i, (mu, run)) in runs.into_iter().enumerate() {
+    for (i, mu, run) in runs {
         let stem = format!("{i:02}_{speed:.0}rpm_mu{mu:.3}");
         match run {
             Ok(r) => {

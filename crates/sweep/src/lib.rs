@@ -6,6 +6,8 @@
 //! - [`render`] and [`fonts`]: charts with an embedded font (no system fonts needed).
 //! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
 //!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
+//! - [`shard`] and [`merge`]: a sweep split over machines and joined again.
+//! - [`compare`]: what changed between two results (nightly jobs).
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
 //! - [`accuracy`] and [`accuracy_chart`]: the work-precision study (`whirlmap accuracy`).
 #![warn(missing_docs)]
@@ -14,13 +16,16 @@ pub mod accuracy;
 pub mod accuracy_chart;
 pub mod charts;
 pub mod classify;
+pub mod compare;
 pub mod critical;
 pub mod extras;
 pub mod extremes;
 pub mod fonts;
+pub mod merge;
 pub mod overrides;
 pub mod recheck;
 pub mod record;
 pub mod render;
+pub mod shard;
 pub mod spec;
 pub mod sweep;

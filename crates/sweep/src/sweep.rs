@@ -61,7 +61,7 @@ pub enum SweepError {
     },
 }
 
-fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError + '_ {
+pub(crate) fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError + '_ {
     move |source| SweepError::Io {
         path: path.to_path_buf(),
         source,
@@ -247,6 +247,12 @@ struct Manifest<'a> {
     threads: usize,
     counts: Counts,
     classes: &'a BTreeMap<String, usize>,
+    /// A shard run's part of the grid (`crate::shard`); absent for a whole run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shard: Option<Value>,
+    /// The shards a merged result was made from (`crate::merge`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    merged_from: Option<Value>,
 }
 
 #[derive(Serialize)]
@@ -257,14 +263,14 @@ struct Counts {
     skipped: usize,
 }
 
-fn unix_now() -> f64 {
+pub(crate) fn unix_now() -> f64 {
     SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_secs_f64())
         .unwrap_or(0.0)
 }
 
-fn git_commit() -> Option<String> {
+pub(crate) fn git_commit() -> Option<String> {
     let out = std::process::Command::new("git")
         .args(["rev-parse", "HEAD"])
         .stderr(std::process::Stdio::null())
@@ -486,17 +492,94 @@ fn write_summary(path: &Path, points: &[Point], lines: &[Value]) -> Result<(), S
     std::fs::write(path, out).map_err(io_err(path))
 }
 
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
     let tmp = path.with_extension("tmp");
     std::fs::write(&tmp, bytes).map_err(io_err(&tmp))?;
     std::fs::rename(&tmp, path).map_err(io_err(path))
 }
 
+/// Run facts for the manifest beside the spec and the counts.
+pub(crate) struct RunMeta {
+    pub git_commit: Option<String>,
+    pub started_unix_s: f64,
+    pub ended_unix_s: f64,
+    pub threads: usize,
+    pub skipped: usize,
+    pub shard: Option<Value>,
+    pub merged_from: Option<Value>,
+}
+
+/// Writes `summary.csv` and `manifest.json` for `points` whose `points.jsonl` lines are
+/// `lines` (same order; an empty line for a point without a record). Returns (ok, failed,
+/// class counts).
+pub(crate) fn write_summary_and_manifest(
+    spec: &SweepSpec,
+    out: &Path,
+    points: &[Point],
+    lines: &[&str],
+    meta: RunMeta,
+) -> Result<(usize, usize, BTreeMap<String, usize>), SweepError> {
+    let values: Vec<Value> = lines
+        .iter()
+        .map(|l| serde_json::from_str(l).unwrap_or(Value::Null))
+        .collect();
+    let mut classes = BTreeMap::new();
+    let mut ok = 0;
+    for v in &values {
+        if v.get("status").and_then(Value::as_str) == Some("ok") {
+            ok += 1;
+            if let Some(c) = v
+                .get("record")
+                .and_then(|r| r.get("class"))
+                .and_then(Value::as_str)
+            {
+                *classes.entry(c.to_string()).or_insert(0) += 1;
+            }
+        }
+    }
+    let failed = points.len() - ok;
+    write_summary(&out.join(SUMMARY_FILE), points, &values)?;
+    let manifest = Manifest {
+        spec,
+        whirlmap_version: env!("CARGO_PKG_VERSION"),
+        model_version: MODEL_VERSION,
+        git_commit: meta.git_commit,
+        started_unix_s: meta.started_unix_s,
+        ended_unix_s: meta.ended_unix_s,
+        threads: meta.threads,
+        counts: Counts {
+            points: points.len(),
+            ok,
+            failed,
+            skipped: meta.skipped,
+        },
+        classes: &classes,
+        shard: meta.shard,
+        merged_from: meta.merged_from,
+    };
+    let text = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
+    write_atomic(&out.join(MANIFEST_FILE), format!("{text}\n").as_bytes())?;
+    Ok((ok, failed, classes))
+}
+
 /// Runs the sweep and writes its outputs. Failed points are recorded, not errors; errors
 /// are an unusable spec or output folder (before anything runs) or an I/O failure.
 pub fn run_sweep(spec: &SweepSpec, opts: &RunOptions) -> Result<SweepOutcome, SweepError> {
+    run_sweep_part(spec, opts, None)
+}
+
+/// [`run_sweep`] over the grid points a shard owns (all of them for `None`); the manifest
+/// then names the shard. See [`crate::shard`].
+pub fn run_sweep_part(
+    spec: &SweepSpec,
+    opts: &RunOptions,
+    shard: Option<&crate::shard::Shard>,
+) -> Result<SweepOutcome, SweepError> {
     let started = unix_now();
-    let points = spec.points()?;
+    let mut points = spec.points()?;
+    if let Some(sh) = shard {
+        points.retain(|p| sh.owns(p.index));
+    }
     let out = &opts.out_dir;
     check_output_dir(out)?;
     let mut builder = rayon::ThreadPoolBuilder::new();
@@ -600,44 +683,16 @@ pub fn run_sweep(spec: &SweepSpec, opts: &RunOptions) -> Result<SweepOutcome, Sw
         write_atomic(&points_path, text.as_bytes())?;
     }
 
-    let values: Vec<Value> = lines
-        .iter()
-        .map(|l| serde_json::from_str(l).unwrap_or(Value::Null))
-        .collect();
-    let mut classes = BTreeMap::new();
-    let mut ok = 0;
-    for v in &values {
-        if v.get("status").and_then(Value::as_str) == Some("ok") {
-            ok += 1;
-            if let Some(c) = v
-                .get("record")
-                .and_then(|r| r.get("class"))
-                .and_then(Value::as_str)
-            {
-                *classes.entry(c.to_string()).or_insert(0) += 1;
-            }
-        }
-    }
-    let failed = points.len() - ok;
-    write_summary(&out.join(SUMMARY_FILE), &points, &values)?;
-    let manifest = Manifest {
-        spec,
-        whirlmap_version: env!("CARGO_PKG_VERSION"),
-        model_version: MODEL_VERSION,
+    let meta = RunMeta {
         git_commit: git_commit(),
         started_unix_s: started,
         ended_unix_s: unix_now(),
         threads,
-        counts: Counts {
-            points: points.len(),
-            ok,
-            failed,
-            skipped,
-        },
-        classes: &classes,
+        skipped,
+        shard: shard.map(|s| s.manifest_tag()),
+        merged_from: None,
     };
-    let text = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-    write_atomic(&out.join(MANIFEST_FILE), format!("{text}\n").as_bytes())?;
+    let (ok, failed, classes) = write_summary_and_manifest(spec, out, &points, &lines, meta)?;
     Ok(SweepOutcome {
         points: points.len(),
         ok,

@@ -1,0 +1,510 @@
+//! Compares two sweep results (a baseline and a new run, e.g. last night's and tonight's):
+//! what a nightly job reports.
+//!
+//! - Per grid point (matched by its inputs, so a new model version whose keys differ is still
+//!   compared point by point): a class change, an ok/failed change, or a relative change of
+//!   the maximum contact force or the peak heat power beyond its threshold
+//!   (`|new - base| / |base|`). A point in only one of the two is a change too.
+//! - Per friction coefficient of `critical.json`: a shift of the critical speed larger than
+//!   the two brackets allow, i.e. the brackets do not overlap; a transition found in one run
+//!   and not in the other is a change as well. Overlapping brackets are "the same": the search
+//!   cannot tell the speeds apart.
+//!
+//! [`compare`] returns the findings; [`write_report`] writes them as Markdown with a class map
+//! of the new run whose changed cells are outlined.
+
+use crate::charts::{
+    assemble_grid, draw_marked_class_map, load_critical, load_points, ChartError, CriticalEntry,
+    PointRow, PointStatus,
+};
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Relative changes above which a point counts as changed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Thresholds {
+    /// Maximum contact force, relative (0.05 = 5 %).
+    pub force_rel: f64,
+    /// Peak heat power, relative.
+    pub power_rel: f64,
+}
+
+impl Default for Thresholds {
+    /// 5 % for both: far above the solver's own scatter (forces agree to 0.001 % between
+    /// rtol 1e-5 and 1e-9, see the README), well below a design-relevant change. A choice,
+    /// not a measured optimum.
+    fn default() -> Self {
+        Self {
+            force_rel: 0.05,
+            power_rel: 0.05,
+        }
+    }
+}
+
+impl Thresholds {
+    /// Checks that both are finite and >= 0; the error names the option.
+    pub fn validate(&self) -> Result<(), String> {
+        for (name, v) in [
+            ("--force-rel", self.force_rel),
+            ("--power-rel", self.power_rel),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} = {v} is out of range: allowed [0, inf)"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One point that changed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointChange {
+    /// `name=value, ...` of the point.
+    pub inputs: String,
+    /// What changed, one entry per quantity (`class pendulum -> backward_whirl`, ...).
+    pub what: Vec<String>,
+    /// The point in the new run (`None` if it is only in the baseline).
+    pub new_row: Option<PointRow>,
+}
+
+/// One friction coefficient whose critical speed moved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CriticalChange {
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Baseline bracket (r/min), `None` if no transition or not searched.
+    pub baseline: Option<[f64; 2]>,
+    /// New bracket.
+    pub new: Option<[f64; 2]>,
+    /// In words.
+    pub what: String,
+}
+
+/// The findings of a comparison.
+#[derive(Debug, Clone)]
+pub struct Comparison {
+    /// The baseline folder.
+    pub baseline: PathBuf,
+    /// The new folder.
+    pub new: PathBuf,
+    /// The thresholds used.
+    pub thresholds: Thresholds,
+    /// Points compared (present in both).
+    pub points_compared: usize,
+    /// Points that changed beyond the thresholds, in the new run's order.
+    pub points: Vec<PointChange>,
+    /// Critical searches compared (present in both).
+    pub critical_compared: usize,
+    /// Critical speeds that moved beyond the brackets.
+    pub critical: Vec<CriticalChange>,
+    /// Both runs' manifests' `spec.name`, `model_version` (for the report header).
+    pub runs: [RunInfo; 2],
+    /// The new run's rows (for the class map).
+    new_rows: Vec<PointRow>,
+}
+
+impl Comparison {
+    /// Whether anything changed beyond the thresholds.
+    pub fn changed(&self) -> bool {
+        !self.points.is_empty() || !self.critical.is_empty()
+    }
+}
+
+/// What a run's manifest says about it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RunInfo {
+    /// The spec's name.
+    pub name: String,
+    /// The model version.
+    pub model_version: String,
+    /// The git commit, if recorded.
+    pub git_commit: String,
+}
+
+fn run_info(dir: &Path) -> RunInfo {
+    let m: Value = std::fs::read_to_string(dir.join("manifest.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or(Value::Null);
+    let text = |v: Option<&Value>| match v {
+        Some(Value::String(s)) => s.clone(),
+        Some(Value::Null) | None => "?".to_string(),
+        Some(v) => v.to_string(),
+    };
+    RunInfo {
+        name: text(m.get("spec").and_then(|s| s.get("name"))),
+        model_version: text(m.get("model_version")),
+        git_commit: text(m.get("git_commit")),
+    }
+}
+
+/// Canonical text of a point's inputs (sorted names, JSON numbers): the matching key.
+fn inputs_key(r: &PointRow) -> String {
+    serde_json::to_string(&r.inputs).expect("inputs serialise")
+}
+
+fn inputs_text(r: &PointRow) -> String {
+    r.inputs
+        .iter()
+        .map(|(k, v)| match v.as_f64() {
+            Some(x) => format!("{k}={x}"),
+            None => format!("{k}={v}"),
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn class_name(r: &PointRow) -> String {
+    match (r.status, r.class) {
+        (PointStatus::Failed, _) => "failed".to_string(),
+        (_, Some(c)) => serde_json::to_value(c)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_else(|| format!("{c:?}")),
+        (_, None) => "none".to_string(),
+    }
+}
+
+/// `Some(description)` when `new` differs from `base` by more than `rel` relatively.
+fn rel_change(
+    name: &str,
+    unit: &str,
+    base: Option<f64>,
+    new: Option<f64>,
+    rel: f64,
+) -> Option<String> {
+    match (base, new) {
+        (Some(b), Some(n)) => {
+            let change = if b == 0.0 {
+                if n == 0.0 {
+                    0.0
+                } else {
+                    f64::INFINITY
+                }
+            } else {
+                (n - b) / b.abs()
+            };
+            (change.abs() > rel)
+                .then(|| format!("{name} {b:.1} -> {n:.1} {unit} ({:+.1} %)", 100.0 * change))
+        }
+        (None, None) => None,
+        (b, n) => Some(format!(
+            "{name} {} -> {}",
+            b.map_or("none".to_string(), |v| format!("{v:.1} {unit}")),
+            n.map_or("none".to_string(), |v| format!("{v:.1} {unit}"))
+        )),
+    }
+}
+
+fn fmt_bracket(b: Option<[f64; 2]>) -> String {
+    b.map_or("no transition".to_string(), |[lo, hi]| {
+        format!("{lo:.0}-{hi:.0} r/min")
+    })
+}
+
+fn compare_critical(base: &[CriticalEntry], new: &[CriticalEntry]) -> (usize, Vec<CriticalChange>) {
+    let mut changes = Vec::new();
+    let mut compared = 0;
+    let find = |list: &[CriticalEntry], mu: f64| {
+        list.iter()
+            .find(|e| (e.mu - mu).abs() <= 1e-12 * mu.abs().max(1.0))
+            .cloned()
+    };
+    for n in new {
+        let Some(b) = find(base, n.mu) else {
+            changes.push(CriticalChange {
+                mu: n.mu,
+                baseline: None,
+                new: n.result.bracket,
+                what: "searched in the new run only".into(),
+            });
+            continue;
+        };
+        compared += 1;
+        let (bb, nb) = (b.result.bracket, n.result.bracket);
+        let what = match (bb, nb) {
+            (Some([blo, bhi]), Some([nlo, nhi])) if nhi < blo || nlo > bhi => Some(format!(
+                "moved {} (brackets do not overlap)",
+                if nlo > bhi { "up" } else { "down" }
+            )),
+            (Some(_), Some(_)) | (None, None) => None,
+            (Some(_), None) => Some("transition no longer found".into()),
+            (None, Some(_)) => Some("transition found, none before".into()),
+        };
+        if let Some(what) = what {
+            changes.push(CriticalChange {
+                mu: n.mu,
+                baseline: bb,
+                new: nb,
+                what,
+            });
+        }
+    }
+    for b in base {
+        if find(new, b.mu).is_none() {
+            changes.push(CriticalChange {
+                mu: b.mu,
+                baseline: b.result.bracket,
+                new: None,
+                what: "searched in the baseline only".into(),
+            });
+        }
+    }
+    (compared, changes)
+}
+
+/// Compares the result folders `baseline` and `new` (each with `points.jsonl`, optionally
+/// `critical.json` and `manifest.json`).
+pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison, ChartError> {
+    let base_rows = load_points(baseline)?;
+    let new_rows = load_points(new)?;
+    let mut base_by: BTreeMap<String, &PointRow> = BTreeMap::new();
+    for r in &base_rows {
+        base_by.insert(inputs_key(r), r); // a rerun line replaces an earlier one
+    }
+    let mut new_by: BTreeMap<String, &PointRow> = BTreeMap::new();
+    for r in &new_rows {
+        new_by.insert(inputs_key(r), r);
+    }
+    let mut points = Vec::new();
+    let mut compared = 0;
+    let mut seen = std::collections::BTreeSet::new();
+    for r in &new_rows {
+        let key = inputs_key(r);
+        if !seen.insert(key.clone()) {
+            continue;
+        }
+        let n = new_by[&key];
+        let mut what = Vec::new();
+        match base_by.get(&key) {
+            None => what.push("not in the baseline".to_string()),
+            Some(b) => {
+                compared += 1;
+                let (bc, nc) = (class_name(b), class_name(n));
+                if bc != nc {
+                    what.push(format!("class {bc} -> {nc}"));
+                }
+                what.extend(rel_change(
+                    "max force",
+                    "N",
+                    b.max_contact_force_n,
+                    n.max_contact_force_n,
+                    t.force_rel,
+                ));
+                what.extend(rel_change(
+                    "peak heat power",
+                    "W",
+                    b.peak_heat_power_w,
+                    n.peak_heat_power_w,
+                    t.power_rel,
+                ));
+            }
+        }
+        if !what.is_empty() {
+            points.push(PointChange {
+                inputs: inputs_text(n),
+                what,
+                new_row: Some(n.clone()),
+            });
+        }
+    }
+    for (key, b) in &base_by {
+        if !new_by.contains_key(key) {
+            points.push(PointChange {
+                inputs: inputs_text(b),
+                what: vec!["not in the new run".to_string()],
+                new_row: None,
+            });
+        }
+    }
+    let (critical_compared, critical) = match (load_critical(baseline)?, load_critical(new)?) {
+        (None, None) => (0, Vec::new()),
+        (b, n) => compare_critical(&b.unwrap_or_default(), &n.unwrap_or_default()),
+    };
+    Ok(Comparison {
+        baseline: baseline.to_path_buf(),
+        new: new.to_path_buf(),
+        thresholds: t,
+        points_compared: compared,
+        points,
+        critical_compared,
+        critical,
+        runs: [run_info(baseline), run_info(new)],
+        new_rows,
+    })
+}
+
+/// Writes the Markdown report to `path` and the class map of the new run with the changed
+/// cells outlined beside it (`<stem>-classes.png`). Returns the image's path.
+pub fn write_report(c: &Comparison, path: &Path) -> Result<PathBuf, ChartError> {
+    let write_err = |path: &Path| {
+        let path = path.to_path_buf();
+        move |cause| ChartError::Write { path, cause }
+    };
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(write_err(dir))?;
+    }
+    let stem = path
+        .file_stem()
+        .map_or("compare".into(), |s| s.to_string_lossy().into_owned());
+    let png = path.with_file_name(format!("{stem}-classes.png"));
+    let grid = assemble_grid(&c.new_rows);
+    let mut marked = Vec::new();
+    for (j, _) in grid.mus.iter().enumerate() {
+        for (i, _) in grid.speeds_rpm.iter().enumerate() {
+            if let Some(cell) = grid.cell(i, j) {
+                let key = inputs_key(cell);
+                if c.points
+                    .iter()
+                    .any(|p| p.new_row.as_ref().is_some_and(|r| inputs_key(r) == key))
+                {
+                    marked.push((i, j));
+                }
+            }
+        }
+    }
+    draw_marked_class_map(
+        &png,
+        &grid,
+        "Orbit class of the new run; changed cells outlined",
+        &marked,
+    )?;
+
+    let t = &c.thresholds;
+    let mut md = String::new();
+    let _ = writeln!(md, "# whirlmap compare\n");
+    let _ = writeln!(
+        md,
+        "**{}**: {} of {} points and {} of {} critical speeds changed beyond the thresholds.\n",
+        if c.changed() { "CHANGED" } else { "SAME" },
+        c.points.len(),
+        c.points_compared,
+        c.critical.len(),
+        c.critical_compared
+    );
+    let _ = writeln!(md, "| | baseline | new |\n|---|---|---|");
+    let _ = writeln!(
+        md,
+        "| folder | `{}` | `{}` |",
+        c.baseline.display(),
+        c.new.display()
+    );
+    let [b, n] = &c.runs;
+    let _ = writeln!(md, "| sweep | {} | {} |", b.name, n.name);
+    let _ = writeln!(
+        md,
+        "| model version | {} | {} |",
+        b.model_version, n.model_version
+    );
+    let _ = writeln!(md, "| git commit | {} | {} |\n", b.git_commit, n.git_commit);
+    let _ = writeln!(
+        md,
+        "Thresholds: maximum contact force {} %, peak heat power {} % (relative to the \
+         baseline); a critical speed has moved when the two brackets do not overlap.\n",
+        100.0 * t.force_rel,
+        100.0 * t.power_rel
+    );
+    let _ = writeln!(md, "## Points\n");
+    if c.points.is_empty() {
+        let _ = writeln!(md, "No point changed.\n");
+    } else {
+        let _ = writeln!(md, "| point | change |\n|---|---|");
+        for p in &c.points {
+            let _ = writeln!(md, "| {} | {} |", p.inputs, p.what.join("; "));
+        }
+        let _ = writeln!(md);
+    }
+    let _ = writeln!(md, "## Critical speeds\n");
+    if c.critical.is_empty() {
+        let _ = writeln!(
+            md,
+            "{}\n",
+            if c.critical_compared == 0 {
+                "No critical-speed search to compare."
+            } else {
+                "No critical speed moved beyond its brackets."
+            }
+        );
+    } else {
+        let _ = writeln!(md, "| mu | baseline | new | change |\n|---|---|---|---|");
+        for k in &c.critical {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} |",
+                k.mu,
+                fmt_bracket(k.baseline),
+                fmt_bracket(k.new),
+                k.what
+            );
+        }
+        let _ = writeln!(md);
+    }
+    let _ = writeln!(
+        md,
+        "## Class map\n\n![class map, changed cells outlined]({})",
+        png.file_name().unwrap_or_default().to_string_lossy()
+    );
+    std::fs::write(path, md).map_err(write_err(path))?;
+    Ok(png)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_changes_respect_the_threshold() {
+        assert_eq!(rel_change("f", "N", Some(100.0), Some(104.9), 0.05), None);
+        assert!(rel_change("f", "N", Some(100.0), Some(105.1), 0.05)
+            .unwrap()
+            .contains("+5.1 %"));
+        assert!(rel_change("f", "N", Some(100.0), Some(94.0), 0.05).is_some());
+        assert!(rel_change("f", "N", Some(0.0), Some(1.0), 0.05).is_some());
+        assert_eq!(rel_change("f", "N", Some(0.0), Some(0.0), 0.0), None);
+        assert!(rel_change("f", "N", Some(1.0), None, 0.05).is_some());
+    }
+
+    fn entry(mu: f64, bracket: Option<[f64; 2]>) -> CriticalEntry {
+        CriticalEntry {
+            mu,
+            result: crate::charts::CriticalResult {
+                bracket,
+                ..Default::default()
+            },
+        }
+    }
+
+    #[test]
+    fn critical_speeds_move_only_when_brackets_are_disjoint() {
+        let base = [entry(0.3, Some([4000.0, 4500.0])), entry(0.4, None)];
+        // Overlapping: the same.
+        let (n, ch) = compare_critical(
+            &base,
+            &[entry(0.3, Some([4400.0, 4900.0])), entry(0.4, None)],
+        );
+        assert_eq!((n, ch.len()), (2, 0));
+        // Touching ends overlap too.
+        let (_, ch) = compare_critical(
+            &base,
+            &[entry(0.3, Some([4500.0, 4900.0])), entry(0.4, None)],
+        );
+        assert!(ch.is_empty());
+        // Disjoint: moved up; a new transition: changed.
+        let (_, ch) = compare_critical(
+            &base,
+            &[
+                entry(0.3, Some([4600.0, 5000.0])),
+                entry(0.4, Some([3000.0, 3500.0])),
+            ],
+        );
+        assert_eq!(ch.len(), 2);
+        assert!(ch[0].what.contains("moved up"), "{:?}", ch[0]);
+        assert!(ch[1].what.contains("found"), "{:?}", ch[1]);
+        // A mu searched only in one run.
+        let (n, ch) = compare_critical(&base, &[entry(0.3, Some([4000.0, 4500.0]))]);
+        assert_eq!((n, ch.len()), (1, 1));
+        assert!(ch[0].what.contains("baseline only"));
+    }
+}

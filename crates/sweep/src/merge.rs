@@ -1,0 +1,518 @@
+//! Joins the output folders of the shards of one sweep ([`crate::shard`]) into one result.
+//!
+//! The merge refuses, listing every problem it finds, when
+//! - a folder is not a shard's output (no `shard.json`), or the shards come from different
+//!   specs (spec hash), shard counts or model versions, or from another model version than
+//!   this binary's;
+//! - a grid point is missing (named with its index and inputs, grouped by the shard that owns
+//!   it, which is named with its folder and whether it finished), present twice, or not in
+//!   the spec's grid;
+//! - a shard lacks its critical-speed searches or orbit panels.
+//!
+//! Otherwise it writes `points.jsonl` (the shards' lines, verbatim, in grid order),
+//! `summary.csv`, `critical.json` and `orbits/` byte-identical to a single-machine run of the
+//! same spec, a `manifest.json` of the same form (counts and classes identical; run times,
+//! threads and git commit taken from the shards, plus `merged_from`), `timings.jsonl` (the
+//! shards' wall times in grid order), and the charts.
+
+use crate::charts::{render_all, ChartError};
+use crate::extras::orbit_panels;
+use crate::shard::{read_shard_manifest, spec_hash, Shard, ShardManifest};
+use crate::spec::{check_output_dir, Point, SpecError};
+use crate::sweep::{
+    io_err, point_key, write_atomic, write_summary_and_manifest, RunMeta, SweepError,
+    MANIFEST_FILE, POINTS_FILE, TIMINGS_FILE,
+};
+use serde_json::{json, Value};
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+use whirlmap_core::MODEL_VERSION;
+
+/// Missing points listed per shard in an error, at most.
+const MAX_LISTED: usize = 20;
+
+/// Why a merge did not produce a result.
+#[derive(Debug, Error)]
+pub enum MergeError {
+    /// The shards do not make one complete result; every problem found, one per entry.
+    #[error("merge refused:\n  - {}", .0.join("\n  - "))]
+    Refused(Vec<String>),
+    /// The spec stored in the shards is unusable.
+    #[error(transparent)]
+    Spec(#[from] SpecError),
+    /// An output could not be written.
+    #[error(transparent)]
+    Output(#[from] SweepError),
+    /// The charts could not be drawn.
+    #[error("charts: {0}")]
+    Charts(#[from] ChartError),
+}
+
+impl MergeError {
+    /// The process exit code: 2 refused or bad input, 4 an output failed.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            MergeError::Refused(_) | MergeError::Spec(_) => 2,
+            MergeError::Output(SweepError::Spec(SpecError::Output { .. })) => 4,
+            MergeError::Output(SweepError::Spec(_)) => 2,
+            MergeError::Output(_) | MergeError::Charts(_) => 4,
+        }
+    }
+}
+
+/// What a merge wrote.
+#[derive(Debug, Clone)]
+pub struct MergeOutcome {
+    /// The sweep's name.
+    pub name: String,
+    /// The number of shards.
+    pub shards: usize,
+    /// Grid points.
+    pub points: usize,
+    /// Points recorded ok.
+    pub ok: usize,
+    /// Points recorded failed.
+    pub failed: usize,
+    /// Class name -> count over the ok points.
+    pub classes: BTreeMap<String, usize>,
+    /// Chart files drawn.
+    pub charts: Vec<PathBuf>,
+}
+
+/// One shard folder as read.
+struct ShardDir {
+    dir: PathBuf,
+    m: ShardManifest,
+    /// The shard's `manifest.json` (written when its grid points finished), if readable.
+    finished: Option<Value>,
+}
+
+impl ShardDir {
+    fn shard(&self) -> Shard {
+        Shard {
+            index: self.m.shard,
+            count: self.m.shards,
+        }
+    }
+    fn name(&self) -> String {
+        let done = if self.m.complete {
+            ""
+        } else {
+            ", did not finish"
+        };
+        format!(
+            "shard {} ({}{done})",
+            self.shard().label(),
+            self.dir.display()
+        )
+    }
+}
+
+fn point_text(p: &Point) -> String {
+    format!("#{} ({})", p.index, p.inputs_text())
+}
+
+fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardDir>, MergeError> {
+    if dirs.is_empty() {
+        return Err(MergeError::Refused(vec!["no shard folders given".into()]));
+    }
+    let mut shards = Vec::new();
+    let mut problems = Vec::new();
+    for dir in dirs {
+        match read_shard_manifest(dir) {
+            Ok(m) => {
+                let finished = std::fs::read_to_string(dir.join(MANIFEST_FILE))
+                    .ok()
+                    .and_then(|t| serde_json::from_str(&t).ok());
+                shards.push(ShardDir {
+                    dir: dir.clone(),
+                    m,
+                    finished,
+                })
+            }
+            Err(e) => problems.push(e),
+        }
+    }
+    if !problems.is_empty() {
+        return Err(MergeError::Refused(problems));
+    }
+    // Same spec, shard count and model version everywhere, and this binary's model version.
+    let first = &shards[0];
+    for s in &shards {
+        if s.m.spec_hash != spec_hash(&s.m.spec) {
+            problems.push(format!(
+                "{}: the spec hash {} does not match its spec (edited by hand, or written by \
+                 another whirlmap version)",
+                s.dir.display(),
+                s.m.spec_hash
+            ));
+        }
+        if s.m.spec_hash != first.m.spec_hash {
+            problems.push(format!(
+                "the shards come from different specs: {} has spec {} (\"{}\"), {} has spec {} \
+                 (\"{}\")",
+                first.dir.display(),
+                first.m.spec_hash,
+                first.m.spec.name,
+                s.dir.display(),
+                s.m.spec_hash,
+                s.m.spec.name
+            ));
+        }
+        if s.m.model_version != first.m.model_version {
+            problems.push(format!(
+                "the shards come from different model versions: {} has model version {}, {} \
+                 has {}",
+                first.dir.display(),
+                first.m.model_version,
+                s.dir.display(),
+                s.m.model_version
+            ));
+        } else if s.m.model_version != MODEL_VERSION {
+            problems.push(format!(
+                "{} was run with model version {}, this whirlmap has model version \
+                 {MODEL_VERSION}: rerun the shard or merge with the same whirlmap",
+                s.dir.display(),
+                s.m.model_version
+            ));
+        }
+        if s.m.shards != first.m.shards {
+            problems.push(format!(
+                "the shards come from different partitions: {} is shard {}, {} is shard {}",
+                first.dir.display(),
+                first.shard().label(),
+                s.dir.display(),
+                s.shard().label()
+            ));
+        }
+    }
+    if !problems.is_empty() {
+        problems.dedup();
+        return Err(MergeError::Refused(problems));
+    }
+    Ok(shards)
+}
+
+/// Merges the shard folders `dirs` into `out_dir` (see the module docs); draws the charts
+/// the spec lists. `out_dir` must not be one of the shard folders.
+pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeError> {
+    let shards = read_shards(dirs)?;
+    let spec = shards[0].m.spec.clone();
+    let count = shards[0].m.shards;
+    let points = spec.points()?;
+    let keys: Vec<String> = points
+        .iter()
+        .map(|p| point_key(&p.scene, spec.duration_s))
+        .collect();
+    let by_key: HashMap<&str, usize> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, k)| (k.as_str(), i))
+        .collect();
+    let mut problems = Vec::new();
+
+    // Which folders claim each shard.
+    let mut claims: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (d, s) in shards.iter().enumerate() {
+        claims.entry(s.m.shard).or_default().push(d);
+    }
+    for (i, ds) in &claims {
+        if ds.len() > 1 {
+            let names: Vec<String> = ds
+                .iter()
+                .map(|d| shards[*d].dir.display().to_string())
+                .collect();
+            problems.push(format!(
+                "shard {i}/{count} given twice: {}",
+                names.join(", ")
+            ));
+        }
+    }
+
+    // Every record line, by grid index.
+    let mut lines: Vec<Vec<(usize, String)>> = vec![Vec::new(); points.len()];
+    for (d, s) in shards.iter().enumerate() {
+        let path = s.dir.join(POINTS_FILE);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+            Err(e) => {
+                problems.push(format!("{}: {e}", path.display()));
+                continue;
+            }
+        };
+        // A torn last line (no newline) is a record the shard did not finish writing.
+        let complete = text.rfind('\n').map_or(0, |i| i + 1);
+        for (n, line) in text[..complete].lines().enumerate() {
+            let key = serde_json::from_str::<Value>(line)
+                .ok()
+                .and_then(|v| v.get("key").and_then(Value::as_str).map(str::to_string));
+            match key.as_deref().and_then(|k| by_key.get(k)) {
+                Some(&i) => lines[i].push((d, line.to_string())),
+                None => problems.push(format!(
+                    "{} line {}: not a record of a grid point of spec \"{}\" ({})",
+                    path.display(),
+                    n + 1,
+                    spec.name,
+                    key.map_or("no key".to_string(), |k| format!("key {k}"))
+                )),
+            }
+        }
+    }
+    for (p, found) in points.iter().zip(&lines) {
+        if found.len() > 1 {
+            let wher: Vec<String> = found
+                .iter()
+                .map(|(d, _)| shards[*d].dir.display().to_string())
+                .collect();
+            problems.push(format!(
+                "point {} is present {} times: in {}",
+                point_text(p),
+                found.len(),
+                wher.join(", ")
+            ));
+        }
+    }
+    // Missing points, grouped by their owner.
+    let mut missing: BTreeMap<usize, Vec<&Point>> = BTreeMap::new();
+    for (p, found) in points.iter().zip(&lines) {
+        if found.is_empty() {
+            missing
+                .entry(Shard::owner_of(p.index, count))
+                .or_default()
+                .push(p);
+        }
+    }
+    for (owner, ps) in &missing {
+        let owned = points
+            .iter()
+            .filter(|p| Shard::owner_of(p.index, count) == *owner)
+            .count();
+        let who = match claims.get(owner) {
+            Some(ds) => shards[ds[0]].name(),
+            None => format!("shard {owner}/{count} (no folder given)"),
+        };
+        let mut list: Vec<String> = ps.iter().take(MAX_LISTED).map(|p| point_text(p)).collect();
+        if ps.len() > MAX_LISTED {
+            list.push(format!("and {} more", ps.len() - MAX_LISTED));
+        }
+        problems.push(format!(
+            "{who} lacks {} of its {owned} points: {}",
+            ps.len(),
+            list.join(", ")
+        ));
+    }
+    // A shard whose points all arrived but that did not finish (its extras may be missing).
+    for s in &shards {
+        if !s.m.complete && !missing.contains_key(&s.m.shard) {
+            problems.push(format!("{}: rerun it with --resume", s.name()));
+        }
+    }
+
+    // Critical searches: row `k` of a shard's critical.json is its k-th owned position.
+    let mut critical_rows: Vec<Option<Value>> = Vec::new();
+    if let Some(c) = &spec.critical {
+        critical_rows = vec![None; c.mu.len()];
+        for s in &shards {
+            let path = s.dir.join("critical.json");
+            let rows: Option<Vec<Value>> = std::fs::read_to_string(&path)
+                .ok()
+                .and_then(|t| serde_json::from_str(&t).ok());
+            let Some(rows) = rows.filter(|r| r.len() == s.m.critical_mu.len()) else {
+                if !s.m.critical_mu.is_empty() {
+                    let mus: Vec<String> =
+                        s.m.critical_mu
+                            .iter()
+                            .map(|j| c.mu[*j].to_string())
+                            .collect();
+                    problems.push(format!(
+                        "{} lacks its critical-speed searches (mu = {}): {} is missing or \
+                         incomplete",
+                        s.name(),
+                        mus.join(", "),
+                        path.display()
+                    ));
+                }
+                continue;
+            };
+            for (j, row) in s.m.critical_mu.iter().zip(rows) {
+                if row.get("mu").and_then(Value::as_f64) != c.mu.get(*j).copied() {
+                    problems.push(format!(
+                        "{}: row for mu = {} expected, found {}",
+                        path.display(),
+                        c.mu[*j],
+                        row.get("mu").unwrap_or(&Value::Null)
+                    ));
+                }
+                critical_rows[*j] = Some(row);
+            }
+        }
+    }
+
+    // Orbit panels: `orbits/NN_speed_mu.json` (or `.error.txt` for a failed drop).
+    let mut orbit_files: Vec<PathBuf> = Vec::new();
+    let panels = orbit_panels(&spec);
+    // The extras of shards without a folder.
+    for owner in (0..count).filter(|o| !claims.contains_key(o)) {
+        let who = format!("shard {owner}/{count} (no folder given)");
+        if let Some(c) = &spec.critical {
+            let mus: Vec<String> = (0..c.mu.len())
+                .filter(|j| Shard::owner_of(*j, count) == owner)
+                .map(|j| c.mu[j].to_string())
+                .collect();
+            if !mus.is_empty() {
+                problems.push(format!(
+                    "{who} lacks its critical-speed searches (mu = {})",
+                    mus.join(", ")
+                ));
+            }
+        }
+        if let Some((_, mus)) = &panels {
+            let own: Vec<String> = (0..mus.len())
+                .filter(|i| Shard::owner_of(*i, count) == owner)
+                .map(|i| format!("{i} (mu = {})", mus[i]))
+                .collect();
+            if !own.is_empty() {
+                problems.push(format!("{who} lacks orbit panels {}", own.join(", ")));
+            }
+        }
+    }
+    if let Some((speed, mus)) = panels {
+        for s in &shards {
+            for &i in &s.m.orbit_panels {
+                let Some(mu) = mus.get(i) else { continue };
+                let stem = format!("{i:02}_{speed:.0}rpm_mu{mu:.3}");
+                let found = [".json", ".error.txt"]
+                    .iter()
+                    .map(|ext| s.dir.join("orbits").join(format!("{stem}{ext}")))
+                    .find(|p| p.is_file());
+                match found {
+                    Some(p) => orbit_files.push(p),
+                    None => problems.push(format!(
+                        "{} lacks orbit panel {i} (mu = {mu}): no orbits/{stem}.json",
+                        s.name()
+                    )),
+                }
+            }
+        }
+    }
+
+    // The output folder must not be an input.
+    let out_canon = std::fs::canonicalize(out_dir).ok();
+    for s in &shards {
+        if out_canon.is_some() && std::fs::canonicalize(&s.dir).ok() == out_canon {
+            problems.push(format!(
+                "the output folder {} is one of the shard folders: choose another --out",
+                out_dir.display()
+            ));
+        }
+    }
+    if !problems.is_empty() {
+        return Err(MergeError::Refused(problems));
+    }
+
+    // Write.
+    check_output_dir(out_dir).map_err(SweepError::from)?;
+    let chosen: Vec<&str> = lines.iter().map(|l| l[0].1.as_str()).collect();
+    let mut text = String::new();
+    for l in &chosen {
+        text.push_str(l);
+        text.push('\n');
+    }
+    write_atomic(&out_dir.join(POINTS_FILE), text.as_bytes())?;
+    write_timings(&shards, &out_dir.join(TIMINGS_FILE))?;
+    if spec.critical.is_some() {
+        let rows: Vec<Value> = critical_rows.into_iter().flatten().collect();
+        let path = out_dir.join("critical.json");
+        let text = serde_json::to_string_pretty(&rows).expect("rows serialise");
+        std::fs::write(&path, text).map_err(io_err(&path))?;
+    }
+    if !orbit_files.is_empty() {
+        let dir = out_dir.join("orbits");
+        std::fs::create_dir_all(&dir).map_err(io_err(&dir))?;
+        for src in &orbit_files {
+            let dst = dir.join(src.file_name().expect("orbit files have names"));
+            std::fs::copy(src, &dst).map_err(io_err(&dst))?;
+        }
+    }
+    let meta = merged_meta(&shards);
+    let (ok, failed, classes) = write_summary_and_manifest(&spec, out_dir, &points, &chosen, meta)?;
+    let charts = if spec.charts.is_empty() {
+        Vec::new()
+    } else {
+        render_all(out_dir)?
+    };
+    Ok(MergeOutcome {
+        name: spec.name.clone(),
+        shards: count,
+        points: points.len(),
+        ok,
+        failed,
+        classes,
+        charts,
+    })
+}
+
+/// Run facts of the merged manifest: the earliest start and latest end of the shards, their
+/// threads and resumed points summed, the first shard's git commit, and the shards.
+fn merged_meta(shards: &[ShardDir]) -> RunMeta {
+    let field = |s: &ShardDir, k: &str| s.finished.as_ref().and_then(|m| m.get(k)).cloned();
+    let f64s = |k: &'static str| shards.iter().filter_map(move |s| field(s, k)?.as_f64());
+    let counts = |s: &ShardDir, k: &str| {
+        field(s, "counts")
+            .and_then(|c| c.get(k).and_then(Value::as_u64))
+            .unwrap_or(0) as usize
+    };
+    let mut order: Vec<&ShardDir> = shards.iter().collect();
+    order.sort_by_key(|s| s.m.shard);
+    RunMeta {
+        git_commit: order
+            .first()
+            .and_then(|s| field(s, "git_commit"))
+            .and_then(|v| v.as_str().map(str::to_string)),
+        started_unix_s: f64s("started_unix_s").fold(f64::INFINITY, f64::min),
+        ended_unix_s: f64s("ended_unix_s").fold(0.0, f64::max),
+        threads: shards
+            .iter()
+            .filter_map(|s| field(s, "threads")?.as_u64())
+            .sum::<u64>() as usize,
+        skipped: shards.iter().map(|s| counts(s, "skipped")).sum(),
+        shard: None,
+        merged_from: Some(Value::Array(
+            order
+                .iter()
+                .map(|s| {
+                    json!({"shard": s.m.shard, "shards": s.m.shards, "dir": s.dir.display().to_string(),
+                           "points": s.m.points.len(), "spec_hash": s.m.spec_hash})
+                })
+                .collect(),
+        )),
+    }
+}
+
+/// The shards' `timings.jsonl` lines, in grid order (wall times are not deterministic; this
+/// file is for profiling only).
+fn write_timings(shards: &[ShardDir], path: &Path) -> Result<(), SweepError> {
+    let mut rows: Vec<(u64, String)> = Vec::new();
+    for s in shards {
+        let Ok(text) = std::fs::read_to_string(s.dir.join(TIMINGS_FILE)) else {
+            continue;
+        };
+        for line in text.lines() {
+            if let Some(i) = serde_json::from_str::<Value>(line)
+                .ok()
+                .and_then(|v| v.get("index").and_then(Value::as_u64))
+            {
+                rows.push((i, line.to_string()));
+            }
+        }
+    }
+    rows.sort_by_key(|r| r.0);
+    let mut text = String::new();
+    for (_, l) in rows {
+        text.push_str(&l);
+        text.push('\n');
+    }
+    std::fs::write(path, text).map_err(io_err(path))
+}

@@ -1,0 +1,60 @@
+//! `whirlmap merge DIR... [--out DIR]`: join the shards of a sweep into one result (see
+//! `whirlmap_sweep::merge`).
+//!
+//! Exit codes: 0 merged, every point ok; 1 merged, some point failed (recorded as data); 2
+//! refused (a point missing or present twice, shards of different specs, shard counts or
+//! model versions, a folder that is not a shard's) with every problem listed; 4 an output
+//! could not be written.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use whirlmap_sweep::merge::merge;
+
+/// Arguments of `whirlmap merge`.
+#[derive(clap::Args)]
+pub struct MergeArgs {
+    /// The shard output folders (each written by `whirlmap sweep --shard I --shards N`).
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Output folder; default: results/<name> of the shards' spec.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// Runs the subcommand and returns the process exit code.
+pub fn run(a: &MergeArgs) -> ExitCode {
+    let out = match &a.out {
+        Some(o) => o.clone(),
+        None => match whirlmap_sweep::shard::read_shard_manifest(&a.dirs[0]) {
+            Ok(m) => PathBuf::from("results").join(&m.spec.name),
+            Err(e) => {
+                eprintln!("error: merge refused:\n  - {e}");
+                return ExitCode::from(2);
+            }
+        },
+    };
+    match merge(&a.dirs, &out) {
+        Ok(o) => {
+            println!(
+                "merge {}: {} shards, {} points, {} ok, {} failed",
+                o.name, o.shards, o.points, o.ok, o.failed
+            );
+            for (class, n) in &o.classes {
+                println!("  {class:<16} {n}");
+            }
+            println!("  output           {}", out.display());
+            if !o.charts.is_empty() {
+                println!("  charts           {} files", o.charts.len());
+            }
+            if o.failed > 0 {
+                ExitCode::from(1)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

@@ -1,0 +1,65 @@
+//! `whirlmap sweep FILE --shard I --shards N`: run one shard of a sweep (see
+//! `whirlmap_sweep::shard`). Exit codes as for a whole sweep: 0 every owned point ok, 1 some
+//! point failed (records still written), 2 bad input, 4 an output could not be written.
+
+use crate::sweep_cmd::SweepArgs;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use whirlmap_sweep::shard::{run_shard, Shard};
+use whirlmap_sweep::spec::SweepSpec;
+use whirlmap_sweep::sweep::{ProgressMode, RunOptions};
+
+/// Runs shard `index` of `count` of `spec` with the options of `a`.
+pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> ExitCode {
+    let shard = match Shard::new(index, count) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let out_dir = a.out.clone().unwrap_or_else(|| {
+        PathBuf::from("results")
+            .join(&spec.name)
+            .join(shard.dir_name())
+    });
+    let opts = RunOptions {
+        out_dir,
+        threads: a.threads.map(|n| n as usize),
+        resume: a.resume,
+        progress: if a.no_progress {
+            ProgressMode::Off
+        } else {
+            ProgressMode::Auto
+        },
+    };
+    let (outcome, critical) = match run_shard(spec, &opts, shard) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(if e.is_input() { 2 } else { 4 });
+        }
+    };
+    println!(
+        "sweep {} shard {}: {} points, {} ok, {} failed{}",
+        spec.name,
+        shard.label(),
+        outcome.points,
+        outcome.ok,
+        outcome.failed,
+        if outcome.skipped > 0 {
+            format!(" ({} resumed)", outcome.skipped)
+        } else {
+            String::new()
+        }
+    );
+    if let Some(p) = critical {
+        println!("  critical speeds  {}", p.display());
+    }
+    println!("  output           {}", opts.out_dir.display());
+    if outcome.failed > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
