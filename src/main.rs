@@ -170,6 +170,7 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
     let why = match r.stop_reason {
         whirlmap_core::StopReason::DurationReached => "duration reached",
         whirlmap_core::StopReason::WhirlTurnsReached => "stopped: whirl decided",
+        whirlmap_core::StopReason::StopSpeedReached => "stopped: stop speed reached",
     };
     println!(
         "whirlmap drop: {:.0} r/min, mu_d {:.3}, {:.4} s simulated ({why})",

@@ -6,6 +6,7 @@
 //! in [`crate::model::drag`], nowhere else.
 
 use crate::error::InvalidParameter;
+use crate::thermal::ThermalParams;
 use serde::{Deserialize, Serialize};
 
 /// How friction at the rotor-race contact is modelled.
@@ -142,6 +143,16 @@ pub struct Scene {
     pub whirl_stop_turns: f64,
     /// Integrator settings.
     pub solver: SolverSettings,
+    /// Stop the run once the rotor spin |omega_r| falls below this (r/min): the end of a
+    /// coast-down. `null` (default, and left out of the scene's JSON so existing scene hashes
+    /// stay as they were): run to the duration. Allowed [0, 1e6].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop_speed_rpm: Option<f64>,
+    /// The thermal model (paper Sec. 3, eqs. 14-31); `null` (default, left out of the JSON):
+    /// no temperatures, no thermal states, no thermal cost. `{}` takes every default of
+    /// [`ThermalParams`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<ThermalParams>,
 }
 
 impl Default for Scene {
@@ -185,6 +196,8 @@ impl Scene {
             drag_zero_speed_rad_s: 0.1,
             whirl_stop_turns: 5.0,
             solver: SolverSettings::default(),
+            stop_speed_rpm: None,
+            thermal: None,
         }
     }
 
@@ -406,6 +419,17 @@ impl Scene {
         }
         if s.max_events == 0 {
             return Err(InvalidParameter::new("solver.max_events", 0, ">= 1"));
+        }
+        if let Some(v) = self.stop_speed_rpm {
+            check(
+                "stop_speed_rpm",
+                v,
+                (0.0..=1e6).contains(&v),
+                "[0, 1e6] r/min",
+            )?;
+        }
+        if let Some(t) = &self.thermal {
+            t.validate_with(self.race_bore_radius_m(), self.pitch_diameter_m)?;
         }
         Ok(())
     }
