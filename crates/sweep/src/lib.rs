@@ -7,6 +7,7 @@
 //! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
 //!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
+//! - [`thermal_chart`]: node temperatures and thermal load of one thermal drop over time.
 #![warn(missing_docs)]
 
 pub mod charts;
@@ -19,3 +20,4 @@ pub mod record;
 pub mod render;
 pub mod spec;
 pub mod sweep;
+pub mod thermal_chart;
