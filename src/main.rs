@@ -261,6 +261,12 @@ fn print_thermal(th: &whirlmap_core::ThermalReport, end_time_s: f64) {
         "  heat (J)              H_s {:.2} + H_i {:.2} + H_o {:.2} = stored {:.2} + lost to ambient {:.2}",
         h.h_s_j, h.h_i_j, h.h_o_j, h.stored_j, h.lost_to_ambient_j
     );
+    if let Some(last) = th.series.last() {
+        println!(
+            "  heat power H          {:.1} W at the end (macro-step mean)",
+            last.heat_w
+        );
+    }
     println!(
         "  thermal work          {} network steps ({:.0} per simulated second)",
         th.network_steps,

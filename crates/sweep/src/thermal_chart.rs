@@ -1,5 +1,5 @@
 //! The temperature chart of one thermal drop: every network node's temperature over time, and
-//! the thermally induced load F_th (eq. 30) beneath it. Drawn from the report's decimated
+//! beneath it the thermally induced load F_th (eq. 30) and the heat power H (eq. 14). Drawn from the report's decimated
 //! temperature history with the shared styling of [`crate::render`].
 
 use std::path::Path;
@@ -15,7 +15,7 @@ use crate::render::{
 };
 
 /// Size (width, height) in pixels of the temperature figure.
-pub const TEMPERATURE_FIGURE_SIZE: (u32, u32) = (1000, 900);
+pub const TEMPERATURE_FIGURE_SIZE: (u32, u32) = (1000, 1100);
 
 /// One colour per node, in network node order (tab10).
 const NODE_COLOURS: [RGBColor; NODES] = [
@@ -40,7 +40,7 @@ const NODE_LABELS: [&str; NODES] = [
     "housing",
 ];
 
-/// Draws node temperatures (K) and F_th (N) against time to `path` (`.png` or `.svg`).
+/// Draws node temperatures (K), F_th (N) and the heat power (W) against time to `path` (`.png` or `.svg`).
 pub fn draw_temperatures(
     path: &Path,
     title: &str,
@@ -75,10 +75,24 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 impl Figure for TemperatureFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
         let body = chart_header(root, 46, self.title, 22.0)?;
-        let top_h = (body.dim_in_pixel().1 as f64 * 0.66).round() as u32;
-        let (top, bottom) = body.split_vertically(top_h);
+        let h = body.dim_in_pixel().1 as f64;
+        let (top, rest) = body.split_vertically((h * 0.56).round() as u32);
+        let (middle, bottom) = rest.split_vertically((h * 0.22).round() as u32);
         self.draw_temperature_panel(&top)?;
-        self.draw_load_panel(&bottom)
+        self.draw_series_panel(
+            &middle,
+            "Thermally induced bearing load F_th, eq. 30",
+            "F_th (N)",
+            "N",
+            |s| s.load_n,
+        )?;
+        self.draw_series_panel(
+            &bottom,
+            "Heat power H = H_s + H_i + H_o, macro-step mean",
+            "H (W)",
+            "W",
+            |s| s.heat_w,
+        )
     }
 }
 
@@ -143,20 +157,28 @@ impl TemperatureFigure<'_> {
         Ok(())
     }
 
-    fn draw_load_panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+    /// A panel of one quantity of the samples against time, with its peak in the caption.
+    fn draw_series_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        title: &str,
+        y_desc: &str,
+        unit: &str,
+        value: impl Fn(&ThermalSample) -> f64,
+    ) -> DrawResult<DB> {
         let peak = self
             .series
             .iter()
-            .map(|s| s.load_n)
+            .map(&value)
             .fold(f64::NEG_INFINITY, f64::max);
         let caption = if peak.is_finite() {
-            format!("Thermally induced bearing load F_th, eq. 30 (peak {peak:.1} N)")
+            format!("{title} (peak {peak:.1} {unit})")
         } else {
-            "Thermally induced bearing load F_th, eq. 30".to_string()
+            title.to_string()
         };
         let area = chart_header(area, 34, &caption, 17.0)?;
         let (t0, t1) = self.t_range();
-        let (lo, hi) = range(self.series.iter().map(|s| s.load_n));
+        let (lo, hi) = range(self.series.iter().map(&value));
         let mut chart = ChartBuilder::on(&area)
             .margin_top(8)
             .margin_bottom(6)
@@ -165,11 +187,11 @@ impl TemperatureFigure<'_> {
             .x_label_area_size(48)
             .y_label_area_size(78)
             .build_cartesian_2d(t0..t1, lo.min(0.0)..hi.max(1.0))?;
-        chart_mesh(&mut chart, "time (s)", "F_th (N)", 10, 5)?;
+        chart_mesh(&mut chart, "time (s)", y_desc, 10, 4)?;
         let pts: Vec<(f64, f64)> = self
             .series
             .iter()
-            .map(|s| (s.t_s, s.load_n))
+            .map(|s| (s.t_s, value(s)))
             .filter(|p| p.0.is_finite() && p.1.is_finite())
             .collect();
         draw_thin_line(&mut chart, &pts, LOAD_COLOUR)

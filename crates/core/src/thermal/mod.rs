@@ -173,6 +173,9 @@ pub struct ThermalSample {
     pub temperatures_k: [f64; NODES],
     /// Thermally induced load F_th (N), eq. 30.
     pub load_n: f64,
+    /// Heat power H = H_s + H_i + H_o (W), eq. 14, averaged over the macro step that ends
+    /// here (0 at release).
+    pub heat_w: f64,
 }
 
 /// What the thermal model reports for one drop.
@@ -250,7 +253,7 @@ impl ThermalRun {
         };
         run.load_n = run.model.expansion.load_n(&run.dt_k);
         run.peak_load_n = run.load_n;
-        run.record(0.0);
+        run.record(0.0, 0.0);
         Ok(run)
     }
 
@@ -264,7 +267,7 @@ impl ThermalRun {
         ((self.syncs + 1) as f64) * self.model.macro_step_s
     }
 
-    fn record(&mut self, t: f64) {
+    fn record(&mut self, t: f64, heat_w: f64) {
         let mut temps = self.dt_k;
         for v in temps.iter_mut() {
             *v += self.model.ambient_k;
@@ -273,6 +276,7 @@ impl ThermalRun {
             t_s: t,
             temperatures_k: temps,
             load_n: self.load_n,
+            heat_w,
         });
     }
 
@@ -306,16 +310,23 @@ impl ThermalRun {
         self.load_n = self.model.expansion.load_n(&self.dt_k);
         self.peak_load_n = self.peak_load_n.max(self.load_n);
         if self.syncs % self.stride == 0 {
-            self.record(t);
+            self.record(t, (e_s + e_b) / h);
         }
         self.load_n
     }
 
     /// Closes the run at `t` (advancing over a last partial macro step) and reports.
     pub fn finish(mut self, t: f64, y: &[f64; N]) -> ThermalReport {
+        let (fric, drag, t_last) = (self.fric_last_j, self.drag_last_j, self.t_last);
         self.advance(t, y);
         if self.series.last().is_none_or(|s| s.t_s < t) {
-            self.record(t);
+            let h = t - t_last;
+            let heat = if h > 0.0 {
+                (y[ix::E_FRIC] - fric + y[ix::E_DRAG] - drag) / h
+            } else {
+                0.0
+            };
+            self.record(t, heat);
         }
         let mut temps = [FinalPeak {
             final_k: 0.0,
