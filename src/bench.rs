@@ -12,7 +12,13 @@ pub struct BenchArgs {
     /// Repetitions per drop case (the median wall time is reported).
     #[arg(long, default_value_t = 5)]
     reps: usize,
+    /// Also run the 60 s thermal coast-down of `scenes/coast-down.json` once (about 15 s).
+    #[arg(long)]
+    coast_down: bool,
 }
+
+/// The coast-down scene, embedded so the bench needs no files.
+const COAST_DOWN_SCENE: &str = include_str!("../scenes/coast-down.json");
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -30,17 +36,41 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         "{:<34} {:>10} {:>11} {:>9} {:>8} {:>7} {:>12}",
         "case", "wall ms", "RHS evals", "steps", "rejected", "events", "ns/RHS eval"
     );
-    for (name, speed, mu) in [
-        ("pendulum 8000 r/min mu 0.1, 1 s", 8000.0, 0.1),
-        ("whirl 8000 r/min mu 0.4 (rule)", 8000.0, 0.4),
-    ] {
-        let mut scene = Scene::paper();
-        scene.speed_rpm = speed;
-        scene.mu_dynamic = mu;
+    let coast: Scene = serde_json::from_str(COAST_DOWN_SCENE)?;
+    let cases = [
+        ("pendulum 8000 r/min mu 0.1, 1 s", 8000.0, 0.1, false, 1.0),
+        ("same, thermal model on", 8000.0, 0.1, true, 1.0),
+        ("whirl 8000 r/min mu 0.4 (rule)", 8000.0, 0.4, false, 1.0),
+        (
+            "thermal coast-down (<= 60 s)",
+            f64::NAN,
+            f64::NAN,
+            true,
+            60.0,
+        ),
+    ];
+    for (name, speed, mu, thermal, duration_s) in cases {
+        let coast_down = speed.is_nan();
+        if coast_down && !a.coast_down {
+            continue;
+        }
+        let mut scene = if coast_down {
+            coast.clone()
+        } else {
+            Scene::paper()
+        };
+        if !coast_down {
+            scene.speed_rpm = speed;
+            scene.mu_dynamic = mu;
+            if thermal {
+                scene.thermal = Some(whirlmap_core::ThermalParams::default());
+            }
+        }
         let opts = DropOptions {
-            duration_s: 1.0,
+            duration_s,
             ..Default::default()
         };
+        let reps = if coast_down { 1 } else { reps };
         let mut walls = Vec::new();
         let mut last = None;
         for _ in 0..reps {
@@ -66,6 +96,14 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             r.stats.events,
             wall * 1e6 / r.stats.rhs_evals as f64
         );
+        if let Some(th) = &r.thermal {
+            println!(
+                "    {:.3} s simulated: {:.0} dynamic RHS evaluations and {:.0} network steps per simulated second",
+                r.end_time_s,
+                r.stats.rhs_evals as f64 / r.end_time_s,
+                th.network_steps as f64 / r.end_time_s
+            );
+        }
     }
     // One right-hand-side evaluation at a loaded, slipping contact (drag on).
     let scene = Scene::paper();

@@ -14,6 +14,7 @@ use whirlmap_sweep::classify::ClassifyParams;
 use whirlmap_sweep::overrides::apply_assignment;
 use whirlmap_sweep::record::DropRecord;
 use whirlmap_sweep::render::{draw_orbit, ImageFormat};
+use whirlmap_sweep::thermal_chart::draw_temperatures;
 
 mod accuracy_cmd;
 mod bench;
@@ -89,6 +90,14 @@ struct DropArgs {
     /// the reduced model last, over the scene file and --set. Default: the scene's settings.
     #[arg(long)]
     fidelity: Option<whirlmap_core::Fidelity>,
+    /// Switch the thermal model on (paper Sec. 3) with the scene's thermal parameters, or the
+    /// defaults if the scene has none (applied before --set, so `--set thermal.x=...` works).
+    #[arg(long)]
+    thermal: bool,
+    /// Draw the node temperatures and the thermal load over time to this .png or .svg file
+    /// (implies --thermal).
+    #[arg(long)]
+    temperatures: Option<PathBuf>,
 }
 
 /// A failure with its exit code.
@@ -120,6 +129,18 @@ fn build_scene(
     speed_rpm: Option<f64>,
     mu: Option<f64>,
 ) -> anyhow::Result<Scene> {
+    build_scene_with(file, sets, speed_rpm, mu, false)
+}
+
+/// [`build_scene`], switching the thermal model on (defaults, unless the scene file has
+/// thermal parameters) before the `--set` overrides when `thermal`.
+fn build_scene_with(
+    file: Option<&Path>,
+    sets: &[String],
+    speed_rpm: Option<f64>,
+    mu: Option<f64>,
+    thermal: bool,
+) -> anyhow::Result<Scene> {
     let mut scene = match file {
         Some(p) => {
             let text = std::fs::read_to_string(p)
@@ -129,6 +150,9 @@ fn build_scene(
         }
         None => Scene::paper(),
     };
+    if thermal && scene.thermal.is_none() {
+        scene.thermal = Some(whirlmap_core::ThermalParams::default());
+    }
     for s in sets {
         apply_assignment(&mut scene, s).with_context(|| format!("--set {s}"))?;
     }
@@ -143,12 +167,13 @@ fn build_scene(
 }
 
 fn run_drop(a: &DropArgs) -> Result<(), Failure> {
-    let mut scene =
-        build_scene(a.scene.as_deref(), &a.set, a.speed_rpm, a.mu).map_err(Failure::Input)?;
+    let thermal = a.thermal || a.temperatures.is_some();
+    let mut scene = build_scene_with(a.scene.as_deref(), &a.set, a.speed_rpm, a.mu, thermal)
+        .map_err(Failure::Input)?;
     if let Some(f) = a.fidelity {
         f.apply(&mut scene);
     }
-    if let Some(p) = &a.orbit {
+    for p in [&a.orbit, &a.temperatures].into_iter().flatten() {
         ImageFormat::from_path(p).map_err(|e| Failure::Input(e.into()))?;
     }
     let opts = DropOptions {
@@ -171,6 +196,13 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
         );
         draw_orbit(path, &title, orbit).map_err(|e| Failure::Output(e.into()))?;
     }
+    if let (Some(path), Some(th)) = (&a.temperatures, &report.thermal) {
+        let title = format!(
+            "{:.0} r/min, mu = {:.2}: touchdown bearing temperatures over {:.1} s",
+            scene.speed_rpm, scene.mu_dynamic, report.end_time_s
+        );
+        draw_temperatures(path, &title, &th.series).map_err(|e| Failure::Output(e.into()))?;
+    }
     if a.json {
         println!(
             "{}",
@@ -180,6 +212,9 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
         print_summary(&scene, &report, &record, wall_s);
         if let Some(p) = &a.orbit {
             println!("  orbit chart           {}", p.display());
+        }
+        if let Some(p) = &a.temperatures {
+            println!("  temperature chart     {}", p.display());
         }
     }
     Ok(())
@@ -191,6 +226,7 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
     let why = match r.stop_reason {
         whirlmap_core::StopReason::DurationReached => "duration reached",
         whirlmap_core::StopReason::WhirlTurnsReached => "stopped: whirl decided",
+        whirlmap_core::StopReason::StopSpeedReached => "stopped: stop speed reached",
     };
     println!(
         "whirlmap drop: {:.0} r/min, mu_d {:.3}, {:.4} s simulated ({why})",
@@ -225,7 +261,38 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
         "  work                  {} RHS evaluations, {} steps ({} rejected), {} events, {:.3} s wall",
         r.stats.rhs_evals, r.stats.steps, r.stats.rejected, r.stats.events, wall_s
     );
+    if let Some(th) = &r.thermal {
+        print_thermal(th, r.end_time_s);
+    }
     println!("  scene hash            {}", r.scene_hash);
+}
+
+fn print_thermal(th: &whirlmap_core::ThermalReport, end_time_s: f64) {
+    use whirlmap_core::thermal::network::node::NAMES;
+    println!("  temperatures (K)      node: final / peak");
+    for (name, n) in NAMES.iter().zip(th.temperatures_k.as_array()) {
+        println!("    {name:<20}{:.2} / {:.2}", n.final_k, n.peak_k);
+    }
+    println!(
+        "  thermal load F_th     peak {:.2} N, final {:.2} N",
+        th.peak_thermal_load_n, th.final_thermal_load_n
+    );
+    let h = &th.heat;
+    println!(
+        "  heat (J)              H_s {:.2} + H_i {:.2} + H_o {:.2} = stored {:.2} + lost to ambient {:.2}",
+        h.h_s_j, h.h_i_j, h.h_o_j, h.stored_j, h.lost_to_ambient_j
+    );
+    if let Some(last) = th.series.last() {
+        println!(
+            "  heat power H          {:.1} W at the end (macro-step mean)",
+            last.heat_w
+        );
+    }
+    println!(
+        "  thermal work          {} network steps ({:.0} per simulated second)",
+        th.network_steps,
+        th.network_steps as f64 / end_time_s.max(1e-12)
+    );
 }
 
 fn main() -> ExitCode {

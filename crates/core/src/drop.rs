@@ -9,6 +9,7 @@ use crate::ode::{
 };
 use crate::orbit::Orbit;
 use crate::scene::{Method, Scene};
+use crate::thermal::{ThermalReport, ThermalRun};
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
 
@@ -17,7 +18,7 @@ use std::ops::ControlFlow;
 pub const MODEL_VERSION: u32 = 1;
 
 /// Largest first step after a mode switch (s): see [`Dopri5::cap_next_step`].
-const STEP_AFTER_SWITCH_S: f64 = 1e-7;
+pub(crate) const STEP_AFTER_SWITCH_S: f64 = 1e-7;
 
 /// How to run a drop (what is not physics).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -80,6 +81,8 @@ pub enum StopReason {
     /// The contact point completed `whirl_stop_turns` net turns: whirl is decided, and in a
     /// rigid housing it would only grow.
     WhirlTurnsReached,
+    /// The rotor spin fell below the scene's `stop_speed_rpm`: the coast-down is over.
+    StopSpeedReached,
 }
 
 /// The energy audit: initial = final + friction heat + damping loss + drag work.
@@ -121,24 +124,55 @@ pub struct DropReport {
     pub scene_hash: String,
     /// The state at the end (layout in [`crate::model::ix`]).
     pub final_state: [f64; N],
+    /// Temperatures, thermal load and heat, when the scene carries a thermal model.
+    pub thermal: Option<ThermalReport>,
 }
 
-/// Passes every step to an extra observer, then to the monitor (which alone may stop).
+/// Passes every step to an extra observer, then to the monitor, which may stop the run, as
+/// may the coast-down's stop speed; then advances the thermal network over every macro-step
+/// end the step passed.
 struct Tap<'a, O> {
     extra: &'a mut O,
     mon: &'a mut Monitor,
+    /// Stop once |omega_r| falls below this (rad/s); 0 for never.
+    stop_speed_rad_s: f64,
+    /// Set when the stop speed stopped the run.
+    speed_stopped: bool,
+    /// The macro-step coupling, when the scene has a thermal model.
+    thermal: Option<&'a mut ThermalRun>,
+    /// Set when the network advanced, so the driver can update F_th in the system.
+    synced: bool,
 }
 
 impl<O: Observer<DropSystem, N>> Observer<DropSystem, N> for Tap<'_, O> {
     fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
         let _ = self.extra.on_step(sys, step);
-        self.mon.on_step(sys, step)
+        self.mon.on_step(sys, step)?;
+        if self.stop_speed_rad_s > 0.0 && step.dense.y1()[ix::WR].abs() < self.stop_speed_rad_s {
+            self.speed_stopped = true;
+            return ControlFlow::Break(());
+        }
+        if let Some(th) = self.thermal.as_deref_mut() {
+            // Macro-step ends are met on the step's interpolant, so the dynamic steps are not
+            // cut at them (a cut leaves a tiny last step that resets the step-size
+            // controller); the new F_th takes effect from this step's end.
+            let t1 = step.dense.t1();
+            while th.next_boundary() <= t1 {
+                let tb = th.next_boundary();
+                th.advance(tb, &step.dense.eval(tb));
+                self.synced = true;
+            }
+            if self.synced {
+                return ControlFlow::Break(());
+            }
+        }
+        ControlFlow::Continue(())
     }
 }
 
 /// Per-component absolute tolerances: displacements to `rtol * position_scale_m`, speeds and
 /// energies to scales of the problem (impact speed sqrt(2 g s), spin, drop energy).
-fn tolerances(scene: &Scene, sys: &DropSystem) -> StepControl<N> {
+pub(crate) fn tolerances(scene: &Scene, sys: &DropSystem) -> StepControl<N> {
     let s = &scene.solver;
     let rtol = s.rtol;
     let pos = rtol * s.position_scale_m;
@@ -173,7 +207,7 @@ fn tolerances(scene: &Scene, sys: &DropSystem) -> StepControl<N> {
 }
 
 /// The mode after guard `index` fired at state `y` (see [`DropSystem`]'s guards).
-fn next_mode(sys: &DropSystem, y: &[f64; N], index: usize) -> Mode {
+pub(crate) fn next_mode(sys: &DropSystem, y: &[f64; N], index: usize) -> Mode {
     let mut m = sys.mode;
     match index {
         0 => {
@@ -237,12 +271,22 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
         opts.orbit_points,
     );
     mon.start(&sys, &y);
+    // The thermal model, if asked for: the dynamics then run in macro steps (crate::thermal).
+    let mut thermal = match &scene.thermal {
+        Some(p) => Some(ThermalRun::new(scene, p, opts.duration_s, &y)?),
+        None => None,
+    };
+    let stop_speed_rad_s = scene.stop_speed_rpm.unwrap_or(0.0) * std::f64::consts::PI / 30.0;
     let mut t = 0.0;
     let mut switch_loss = 0.0;
     let stop_reason = loop {
         let mut tap = Tap {
             extra: &mut *extra,
             mon: &mut mon,
+            stop_speed_rad_s,
+            speed_stopped: false,
+            thermal: thermal.as_mut(),
+            synced: false,
         };
         match integrate(
             &sys,
@@ -253,6 +297,13 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
             &mut tap,
         )? {
             Stop::EndTime => break StopReason::DurationReached,
+            Stop::Observer if tap.speed_stopped => break StopReason::StopSpeedReached,
+            Stop::Observer if tap.synced => {
+                // The network advanced: F_th (eq. 30) for the next macro step (eq. 31).
+                if let Some(th) = thermal.as_ref() {
+                    sys.thermal_load_n = th.load_n();
+                }
+            }
             Stop::Observer => break StopReason::WhirlTurnsReached,
             Stop::Event { index } => {
                 if stepper.stats().events >= scene.solver.max_events {
@@ -293,6 +344,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
         residual_rel: (e0 - e1 - losses).abs() / scale,
     };
     let (features, orbit) = mon.finish(&sys, t, &y);
+    let thermal = thermal.map(|th| th.finish(t, &y));
     Ok(DropReport {
         features,
         energy,
@@ -302,5 +354,6 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
         orbit,
         scene_hash: scene.hash_hex(),
         final_state: y,
+        thermal,
     })
 }

@@ -21,6 +21,10 @@
 //!   ([`model::friction`]); a regularised law is an option.
 //! - Palmgren drag on the race, eqs. 11-13 ([`model::drag`]).
 //! - Heat: `H_s = F_t v_rel` (eq. 17) and the bearing drag power `M |omega_b|`.
+//! - Optional thermal model ([`thermal`], eqs. 14-31): the bearing heat split into `H_i` and
+//!   `H_o`, the seven-node heat network, expansion and the thermally induced load fed back
+//!   into the drag torque, coupled to the dynamics by macro steps. A scene switches it on
+//!   with `thermal`; without it nothing thermal is computed.
 //!
 //! ## Integrator
 //! [`ode`]: Dormand-Prince 5(4) with dense output; contact onset and loss, support release,
@@ -48,6 +52,7 @@ pub mod monitor;
 pub mod ode;
 pub mod orbit;
 pub mod scene;
+pub mod thermal;
 
 pub use drop::{
     simulate, simulate_observed, DropOptions, DropReport, EnergyAudit, StopReason, MODEL_VERSION,
@@ -56,3 +61,4 @@ pub use error::{InvalidParameter, SolveError};
 pub use fidelity::Fidelity;
 pub use monitor::{Features, Window};
 pub use scene::{FrictionLaw, Method, Scene, SolverSettings};
+pub use thermal::{ThermalParams, ThermalReport};

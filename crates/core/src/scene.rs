@@ -6,6 +6,7 @@
 //! in [`crate::model::drag`], nowhere else.
 
 use crate::error::InvalidParameter;
+use crate::thermal::ThermalParams;
 use serde::{Deserialize, Serialize};
 
 /// How friction at the rotor-race contact is modelled.
@@ -177,6 +178,16 @@ pub struct Scene {
     /// Default false (the paper's model). Omitted from the canonical JSON while false.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub quasi_static_race: bool,
+    /// Stop the run once the rotor spin |omega_r| falls below this (r/min): the end of a
+    /// coast-down. `null` (default, and left out of the scene's JSON so existing scene hashes
+    /// stay as they were): run to the duration. Allowed [0, 1e6].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop_speed_rpm: Option<f64>,
+    /// The thermal model (paper Sec. 3, eqs. 14-31); `null` (default, left out of the JSON):
+    /// no temperatures, no thermal states, no thermal cost. `{}` takes every default of
+    /// [`ThermalParams`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<ThermalParams>,
 }
 
 impl Default for Scene {
@@ -221,6 +232,8 @@ impl Scene {
             whirl_stop_turns: 5.0,
             solver: SolverSettings::default(),
             quasi_static_race: false,
+            stop_speed_rpm: None,
+            thermal: None,
         }
     }
 
@@ -444,6 +457,17 @@ impl Scene {
         }
         if s.max_events == 0 {
             return Err(InvalidParameter::new("solver.max_events", 0, ">= 1"));
+        }
+        if let Some(v) = self.stop_speed_rpm {
+            check(
+                "stop_speed_rpm",
+                v,
+                (0.0..=1e6).contains(&v),
+                "[0, 1e6] r/min",
+            )?;
+        }
+        if let Some(t) = &self.thermal {
+            t.validate_with(self.race_bore_radius_m(), self.pitch_diameter_m)?;
         }
         Ok(())
     }

@@ -118,6 +118,8 @@ pub struct PointRow {
     pub max_contact_force_n: Option<f64>,
     /// Peak heat power (W), if finite.
     pub peak_heat_power_w: Option<f64>,
+    /// Hottest peak node temperature (K), for records made with the thermal model.
+    pub peak_temperature_k: Option<f64>,
     /// The error of a failed point, as text.
     pub error: Option<String>,
 }
@@ -185,6 +187,15 @@ impl From<RawRow> for PointRow {
                 .and_then(|c| serde_json::from_value(c.clone()).ok()),
             max_contact_force_n: finite(rec.and_then(|v| v.get("max_contact_force_n"))),
             peak_heat_power_w: finite(rec.and_then(|v| v.get("peak_heat_power_w"))),
+            peak_temperature_k: rec
+                .and_then(|v| v.get("temperatures_k"))
+                .and_then(Value::as_object)
+                .and_then(|nodes| {
+                    nodes
+                        .values()
+                        .filter_map(|n| finite(n.get("peak")))
+                        .reduce(f64::max)
+                }),
             error,
         }
     }
@@ -1478,7 +1489,7 @@ pub fn draw_marked_class_map(
 
 /// Draws every chart whose data exists in the results directory `dir` into `dir/charts/`, as
 /// PNG and SVG: `fig5_max_force`, `fig6_peak_power` and `classes` from `points.jsonl`
-/// (required), `fig4_critical` if `critical.json` exists, `fig3_orbits` if `orbits/` holds
+/// (required), `peak_temperature` if the records carry temperatures, `fig4_critical` if `critical.json` exists, `fig3_orbits` if `orbits/` holds
 /// orbit files. Returns the paths written, in that order.
 pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
     let rows = load_points(dir)?;
@@ -1513,6 +1524,22 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         bar_label: "",
     };
     write_both(&out_dir, "classes", CHART_SIZE, &classes, &mut written)?;
+    if rows.iter().any(|r| r.peak_temperature_k.is_some()) {
+        // Only records made with the thermal model carry temperatures.
+        let temps = GridFigure {
+            grid: &grid,
+            title: with_slice("Peak touchdown-bearing temperature", &grid.slice),
+            mode: GridMode::Metric(|r| r.peak_temperature_k),
+            bar_label: "hottest node peak temperature (K)",
+        };
+        write_both(
+            &out_dir,
+            "peak_temperature",
+            CHART_SIZE,
+            &temps,
+            &mut written,
+        )?;
+    }
     if let Some(entries) = &critical {
         let fig4 = CriticalFigure {
             entries,
@@ -1631,6 +1658,7 @@ mod tests {
             class: None,
             max_contact_force_n: None,
             peak_heat_power_w: None,
+            peak_temperature_k: None,
             error: None,
         };
         let rows = vec![

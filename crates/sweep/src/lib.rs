@@ -10,6 +10,7 @@
 //! - [`compare`]: what changed between two results (nightly jobs).
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
 //! - [`accuracy`] and [`accuracy_chart`]: the work-precision study (`whirlmap accuracy`).
+//! - [`thermal_chart`]: node temperatures and thermal load of one thermal drop over time.
 #![warn(missing_docs)]
 
 pub mod accuracy;
@@ -29,3 +30,4 @@ pub mod render;
 pub mod shard;
 pub mod spec;
 pub mod sweep;
+pub mod thermal_chart;

@@ -4,6 +4,7 @@
 use crate::classify::{classify, ClassifyParams, OrbitClass};
 use serde::{Deserialize, Serialize};
 use whirlmap_core::ode::Stats;
+use whirlmap_core::thermal::{HeatEnergies, NodeTemperatures};
 use whirlmap_core::{DropReport, EnergyAudit, Features, StopReason, MODEL_VERSION};
 
 /// One drop's outputs, as written by `whirlmap drop --json` and, per point, by sweeps.
@@ -39,6 +40,16 @@ pub struct DropRecord {
     pub model_version: u32,
     /// Every streamed feature (for diagnostics and re-classification).
     pub features: Features,
+    /// Final and peak temperature per network node (K); only with the thermal model (absent
+    /// otherwise, so records without it are unchanged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperatures_k: Option<NodeTemperatures>,
+    /// Peak thermally induced bearing load F_th (N), eq. 30; only with the thermal model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal_load_n: Option<f64>,
+    /// Heat made (H_s, H_i, H_o integrated, J) and where it went; only with the thermal model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heat: Option<HeatEnergies>,
 }
 
 impl DropRecord {
@@ -61,6 +72,9 @@ impl DropRecord {
             scene_hash: r.scene_hash.clone(),
             model_version: MODEL_VERSION,
             features: r.features,
+            temperatures_k: r.thermal.as_ref().map(|t| t.temperatures_k),
+            thermal_load_n: r.thermal.as_ref().map(|t| t.peak_thermal_load_n),
+            heat: r.thermal.as_ref().map(|t| t.heat),
         }
     }
 }

@@ -136,6 +136,10 @@ pub struct DropSystem {
     series: Option<quasi_static::SeriesSprings>,
     /// The current mode; the driver switches it at located events.
     pub mode: Mode,
+    /// Thermally induced bearing load F_th (N), eq. 30, added to the ball-support load in the
+    /// Palmgren load torque (eq. 31). Zero unless the scene's thermal model sets it; the
+    /// macro-step coupling ([`crate::thermal`]) updates it between macro steps.
+    pub thermal_load_n: f64,
 }
 
 impl DropSystem {
@@ -187,6 +191,7 @@ impl DropSystem {
                 support: true,
                 slip: Slip::Slipping(1.0),
             },
+            thermal_load_n: 0.0,
         }
     }
 
@@ -326,10 +331,11 @@ impl DropSystem {
             }
         }
 
-        // Palmgren drag (eqs. 11-13) on the race, P1 = the support force.
+        // Palmgren drag (eqs. 11-13) on the race, P1 = the support force; eq. 31 adds the
+        // thermally induced load (exactly 0.0 without a thermal model, so no bit changes).
         let wb = y[ix::WB];
         if let Some(p) = &self.drag {
-            let m = p.torque_n_m(wb, f.support_n);
+            let m = p.torque_n_m(wb, f.support_n + self.thermal_load_n);
             let dir = drag::direction(wb, self.omega_eps);
             f.drag_torque_n_m = -m * dir;
             f.bearing_power_w = m * dir * wb;

@@ -1,0 +1,403 @@
+//! The seven-node heat network of the paper's Sec. 3.1, eqs. 18-25, with Table 1's thermal
+//! resistances, and its exact step over an interval of constant heat input.
+//!
+//! Nodes ([`node`]): rotor `s`, inner race `i`, inner lubricant `Li`, balls `b`, outer lubricant
+//! `Le`, outer race `o`, housing `h`; ambient `T_inf`. Each node obeys eq. 18,
+//! `m C dT/dt = sum of heat flows`, on the temperature rise `dT = T - T_inf`.
+//!
+//! How the printed equations are resolved (they are not an energy-conserving network as
+//! printed, and two resistances are undefined):
+//! - **R_1 and R_2** (eqs. 20-24) are the ball-side resistances of the inner and the outer
+//!   contact: the lubricant film of Table 1 in series with the balls' own conduction,
+//!   `R_1 = R_Li + R_b` and `R_2 = R_Le + R_b`.
+//! - **A conservative network.** Printed eq. 20 drains the inner race into the balls through
+//!   `R_i + R_1`, but eq. 22 has no matching inflow, and eq. 21 links the inner lubricant to the
+//!   inner race through `R_i` with no matching term in eq. 20 (likewise eqs. 23-24 at the outer
+//!   side). Every link must appear in both its nodes' equations or heat is created or lost. We
+//!   keep the chain the resistances describe: race `i` --R_i-- lubricant `Li` --R_1-- balls
+//!   `b` --R_2-- lubricant `Le` --R_e-- race `o`; eq. 20's `R_i + R_1` is exactly this path
+//!   with the lubricant node in between (as eq. 21 has it). Hence `R_o` of eqs. 23-24 is
+//!   Table 1's `R_e`.
+//! - The other links are as printed: rotor-inner race `R_sr`; rotor-ambient `R_sac + R_sav`
+//!   (conduction along the journal, then convection at its end, eq. 19); balls-ambient `R_La`
+//!   (eq. 22); outer race-housing `R_hrc || R_hac` (eq. 24); housing-ambient `R_hrv || R_hav`
+//!   (eq. 25).
+//! - **Heat inputs.** `H_r` of eqs. 19-20 is eq. 17's `H_s`, half to the rotor and half to the
+//!   inner race (a parameter). The printed shares of `H_i` (inner race, inner lubricant and
+//!   balls each `H_i/2`) sum to 1.5 `H_i`; we give the lubricant node a share (default 1/3) and
+//!   split the rest equally between race and balls, and the same at the outer contact.
+//! - Radii: `r_s` is the rotor journal radius in `R_sac`, `R_sav`; in `R_i` the inner race
+//!   conducts from its bore (the rotor's radius plus the touchdown clearance) to its raceway
+//!   `r_i = d_m/2 - r_b`; the outer race from its raceway `r_e = d_m/2 + r_b` to `r_o = D/2`.
+//!   Table 1's `n` in `R_Li`, `R_Le` is the ball count `z`.
+
+use super::params::ThermalParams;
+use std::f64::consts::PI;
+
+/// Node indices of the network.
+pub mod node {
+    /// Rotor (shaft) journal, eq. 19.
+    pub const ROTOR: usize = 0;
+    /// Inner race, eq. 20.
+    pub const INNER_RACE: usize = 1;
+    /// Lubricant at the inner contact, eq. 21.
+    pub const INNER_LUBRICANT: usize = 2;
+    /// Balls, eq. 22.
+    pub const BALLS: usize = 3;
+    /// Lubricant at the outer contact, eq. 23.
+    pub const OUTER_LUBRICANT: usize = 4;
+    /// Outer race, eq. 24.
+    pub const OUTER_RACE: usize = 5;
+    /// Housing, eq. 25.
+    pub const HOUSING: usize = 6;
+    /// Node names as used in records and charts.
+    pub const NAMES: [&str; 7] = [
+        "rotor",
+        "inner_race",
+        "inner_lubricant",
+        "balls",
+        "outer_lubricant",
+        "outer_race",
+        "housing",
+    ];
+}
+
+/// Number of network nodes.
+pub const NODES: usize = 7;
+
+/// Table 1's thermal resistances (K/W) at a parameter set, plus the resolved `R_1`, `R_2`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(non_snake_case, missing_docs)]
+pub struct Resistances {
+    pub R_i: f64,
+    pub R_e: f64,
+    pub R_sac: f64,
+    pub R_sav: f64,
+    pub R_sr: f64,
+    pub R_hac: f64,
+    pub R_hav: f64,
+    pub R_hrc: f64,
+    pub R_hrv: f64,
+    pub R_b: f64,
+    pub R_Li: f64,
+    pub R_Le: f64,
+    pub R_La: f64,
+    /// `R_Li + R_b` (eqs. 20-22).
+    pub R_1: f64,
+    /// `R_Le + R_b` (eqs. 22-24).
+    pub R_2: f64,
+}
+
+/// Geometry the network takes from the dynamic scene (m, kg).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneGeometry {
+    /// Rotor journal radius r_s.
+    pub rotor_radius_m: f64,
+    /// Inner race bore radius (rotor radius plus clearance).
+    pub race_bore_radius_m: f64,
+    /// Bearing pitch diameter d_m.
+    pub pitch_diameter_m: f64,
+    /// Inner race mass m_i (Table 2).
+    pub inner_race_mass_kg: f64,
+}
+
+impl Resistances {
+    /// Table 1 at `p` and the scene geometry `g`.
+    pub fn new(p: &ThermalParams, g: &SceneGeometry) -> Self {
+        let r_s = g.rotor_radius_m;
+        let r_bore = g.race_bore_radius_m;
+        let r_b = 0.5 * p.ball_diameter_m;
+        let r_i = 0.5 * g.pitch_diameter_m - r_b;
+        let r_e = 0.5 * g.pitch_diameter_m + r_b;
+        let r_o = 0.5 * p.outer_diameter_m;
+        let r_h = p.housing_outer_radius_m;
+        let w = p.bearing_width_m;
+        let z = p.ball_count as f64;
+        let (lam_b, lam_s, lam_h, lam_l) = (
+            p.bearing_conductivity_w_m_k,
+            p.rotor_conductivity_w_m_k,
+            p.housing_conductivity_w_m_k,
+            p.lubricant_conductivity_w_m_k,
+        );
+        let l_h = p.housing_length_m;
+        let ring = r_h * r_h - r_o * r_o;
+        let r_b_res = 1.0 / (z * lam_b * PI * r_b);
+        let r_li = r_b / (lam_l * (2.0 * PI * r_i * w - z * PI * r_b * r_b));
+        let r_le = r_b / (lam_l * (2.0 * PI * r_e * w - z * PI * r_b * r_b));
+        Self {
+            R_i: (r_i / r_bore).ln() / (2.0 * PI * lam_b * w),
+            R_e: (r_o / r_e).ln() / (2.0 * PI * lam_b * w),
+            R_sac: p.rotor_node_length_m / (lam_s * PI * r_s * r_s),
+            R_sav: 1.0 / (p.rotor_convection_w_m2_k * PI * r_s * r_s),
+            R_sr: 1.0 / (lam_s * PI * w),
+            R_hac: l_h / (2.0 * PI * lam_h * ring),
+            R_hav: 1.0 / (PI * p.housing_convection_w_m2_k * ring),
+            R_hrc: (r_h / r_o).ln() / (2.0 * PI * lam_h * l_h),
+            R_hrv: 1.0 / (2.0 * PI * r_h * l_h * p.housing_convection_w_m2_k),
+            R_b: r_b_res,
+            R_Li: r_li,
+            R_Le: r_le,
+            R_La: 1.0 / (p.lubricant_convection_w_m2_k * PI * (r_e * r_e - r_i * r_i)),
+            R_1: r_li + r_b_res,
+            R_2: r_le + r_b_res,
+        }
+    }
+}
+
+/// Parallel combination; an infinite resistance (zero convection) drops out.
+fn parallel(a: f64, b: f64) -> f64 {
+    1.0 / (1.0 / a + 1.0 / b)
+}
+
+/// A linear heat network `C dT/dt = q - G dT` on temperature rises over ambient: node heat
+/// capacities, symmetric links and links to ambient (all as conductances, W/K).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Network {
+    /// Heat capacity `m C` of each node (J/K), eq. 18.
+    pub capacity_j_k: [f64; NODES],
+    /// Links `(a, b, conductance W/K)`; each acts on both of its nodes.
+    pub links: Vec<(usize, usize, f64)>,
+    /// Conductance from each node to ambient (W/K); 0 for none.
+    pub ambient_w_k: [f64; NODES],
+    /// Share of `H_s` into the rotor node (the rest into the inner race).
+    pub rub_heat_to_rotor: f64,
+    /// Share of `H_i` (`H_o`) into the inner (outer) lubricant node.
+    pub contact_heat_to_lubricant: f64,
+}
+
+impl Network {
+    /// The paper's seven-node network (eqs. 19-25 as resolved in the module doc).
+    pub fn paper(p: &ThermalParams, g: &SceneGeometry) -> Self {
+        use node::*;
+        let r = Resistances::new(p, g);
+        let r_b = 0.5 * p.ball_diameter_m;
+        let r_o = 0.5 * p.outer_diameter_m;
+        let ball_mass =
+            p.ball_count as f64 * p.bearing_density_kg_m3 * 4.0 / 3.0 * PI * r_b.powi(3);
+        let rotor_mass =
+            p.rotor_density_kg_m3 * PI * g.rotor_radius_m.powi(2) * p.rotor_node_length_m;
+        let housing_mass = p.housing_density_kg_m3
+            * PI
+            * (p.housing_outer_radius_m.powi(2) - r_o * r_o)
+            * p.housing_length_m;
+        let c_b = p.bearing_specific_heat_j_kg_k;
+        let c_l = p.lubricant_specific_heat_j_kg_k * p.lubricant_mass_kg;
+        let mut capacity = [0.0; NODES];
+        capacity[ROTOR] = rotor_mass * p.rotor_specific_heat_j_kg_k;
+        capacity[INNER_RACE] = g.inner_race_mass_kg * c_b;
+        capacity[INNER_LUBRICANT] = c_l;
+        capacity[BALLS] = ball_mass * c_b;
+        capacity[OUTER_LUBRICANT] = c_l;
+        capacity[OUTER_RACE] = p.outer_race_mass_kg * c_b;
+        capacity[HOUSING] = housing_mass * p.housing_specific_heat_j_kg_k;
+        let mut ambient = [0.0; NODES];
+        // Zero convection gives an infinite resistance: 1 / inf = 0, no link.
+        ambient[ROTOR] = 1.0 / (r.R_sac + r.R_sav);
+        ambient[BALLS] = 1.0 / r.R_La;
+        ambient[HOUSING] = 1.0 / parallel(r.R_hrv, r.R_hav);
+        Self {
+            capacity_j_k: capacity,
+            links: vec![
+                (ROTOR, INNER_RACE, 1.0 / r.R_sr),
+                (INNER_RACE, INNER_LUBRICANT, 1.0 / r.R_i),
+                (INNER_LUBRICANT, BALLS, 1.0 / r.R_1),
+                (BALLS, OUTER_LUBRICANT, 1.0 / r.R_2),
+                (OUTER_LUBRICANT, OUTER_RACE, 1.0 / r.R_e),
+                (OUTER_RACE, HOUSING, 1.0 / parallel(r.R_hrc, r.R_hac)),
+            ],
+            ambient_w_k: ambient,
+            rub_heat_to_rotor: p.rub_heat_to_rotor,
+            contact_heat_to_lubricant: p.contact_heat_to_lubricant,
+        }
+    }
+
+    /// Heat input per node (W) from the rub heat `H_s` and the contact heats `H_i`, `H_o`
+    /// (eqs. 19-24 as resolved): the shares always sum to `H_s + H_i + H_o`.
+    pub fn heat_inputs(&self, h_s: f64, h_i: f64, h_o: f64) -> [f64; NODES] {
+        use node::*;
+        let fl = self.contact_heat_to_lubricant;
+        let to_rotor = self.rub_heat_to_rotor * h_s;
+        let mut q = [0.0; NODES];
+        q[ROTOR] = to_rotor;
+        q[INNER_RACE] = (h_s - to_rotor) + 0.5 * (1.0 - fl) * h_i;
+        q[INNER_LUBRICANT] = fl * h_i;
+        q[BALLS] = 0.5 * (1.0 - fl) * (h_i + h_o);
+        q[OUTER_LUBRICANT] = fl * h_o;
+        q[OUTER_RACE] = 0.5 * (1.0 - fl) * h_o;
+        q
+    }
+
+    /// `G`: the conductance matrix (W/K), symmetric, ambient links on the diagonal.
+    pub fn conductance_matrix(&self) -> [[f64; NODES]; NODES] {
+        let mut g = [[0.0; NODES]; NODES];
+        for &(a, b, c) in &self.links {
+            g[a][a] += c;
+            g[b][b] += c;
+            g[a][b] -= c;
+            g[b][a] -= c;
+        }
+        for (k, c) in self.ambient_w_k.iter().enumerate() {
+            g[k][k] += c;
+        }
+        g
+    }
+
+    /// `d(dT)/dt = C^-1 (q - G dT)` (K/s), eqs. 19-25.
+    pub fn rates(&self, dt_k: &[f64; NODES], q_w: &[f64; NODES]) -> [f64; NODES] {
+        let mut flow = *q_w;
+        for &(a, b, c) in &self.links {
+            let f = c * (dt_k[a] - dt_k[b]);
+            flow[a] -= f;
+            flow[b] += f;
+        }
+        let mut out = [0.0; NODES];
+        for k in 0..NODES {
+            out[k] = (flow[k] - self.ambient_w_k[k] * dt_k[k]) / self.capacity_j_k[k];
+        }
+        out
+    }
+
+    /// Heat flowing to ambient (W) at temperature rises `dt_k`.
+    pub fn loss_w(&self, dt_k: &[f64; NODES]) -> f64 {
+        (0..NODES).map(|k| self.ambient_w_k[k] * dt_k[k]).sum()
+    }
+
+    /// Heat stored (J) at temperature rises `dt_k`: `sum m C dT`.
+    pub fn stored_j(&self, dt_k: &[f64; NODES]) -> f64 {
+        (0..NODES).map(|k| self.capacity_j_k[k] * dt_k[k]).sum()
+    }
+}
+
+/// Size of the augmented system of [`ExactStep`]: seven temperatures, the ambient-loss
+/// accumulator, and seven constant heat inputs.
+const AUG: usize = 2 * NODES + 1;
+
+/// The network's exact step over `h` with constant heat input: `x(h) = Phi x(0) + Gamma q`,
+/// where `x` is the seven temperature rises plus the heat lost to ambient (J). `Phi` and
+/// `Gamma` are the blocks of `exp(h Z)` for the augmented matrix
+/// `Z = [[-C^-1 G, 0, C^-1], [g_amb^T, 0, 0], [0, 0, 0]]` (Van Loan's construction), so the
+/// step is exact for any `h`, however stiff the network, and the loss integral is exact too.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExactStep {
+    /// The step (s).
+    pub h_s: f64,
+    phi: [[f64; NODES + 1]; NODES + 1],
+    gamma: [[f64; NODES]; NODES + 1],
+}
+
+impl ExactStep {
+    /// Precomputes the step of `h_s` for `net`.
+    pub fn new(net: &Network, h_s: f64) -> Self {
+        let g = net.conductance_matrix();
+        let mut z = [[0.0; AUG]; AUG];
+        for a in 0..NODES {
+            for b in 0..NODES {
+                z[a][b] = -g[a][b] / net.capacity_j_k[a] * h_s;
+            }
+            z[a][NODES + 1 + a] = h_s / net.capacity_j_k[a];
+            z[NODES][a] = net.ambient_w_k[a] * h_s;
+        }
+        let e = expm(&z);
+        let mut phi = [[0.0; NODES + 1]; NODES + 1];
+        let mut gamma = [[0.0; NODES]; NODES + 1];
+        for a in 0..=NODES {
+            phi[a].copy_from_slice(&e[a][..=NODES]);
+            gamma[a].copy_from_slice(&e[a][NODES + 1..]);
+        }
+        Self { h_s, phi, gamma }
+    }
+
+    /// Advances temperature rises `dt_k` and the ambient loss `lost_j` over the step with
+    /// constant heat input `q_w`.
+    pub fn advance(&self, dt_k: &mut [f64; NODES], lost_j: &mut f64, q_w: &[f64; NODES]) {
+        let mut x = [0.0; NODES + 1];
+        x[..NODES].copy_from_slice(dt_k);
+        x[NODES] = *lost_j;
+        let mut out = [0.0; NODES + 1];
+        for (a, o) in out.iter_mut().enumerate() {
+            let mut s = 0.0;
+            for b in 0..=NODES {
+                s += self.phi[a][b] * x[b];
+            }
+            for b in 0..NODES {
+                s += self.gamma[a][b] * q_w[b];
+            }
+            *o = s;
+        }
+        dt_k.copy_from_slice(&out[..NODES]);
+        *lost_j = out[NODES];
+    }
+}
+
+/// Matrix exponential by scaling and squaring with a Taylor series: scaled to a 1-norm at
+/// most 1/2, 18 terms leave a truncation error below 1e-22 relative. Hand-written because it
+/// is needed once per run on a 15 x 15 matrix, which does not justify a linear-algebra crate.
+fn expm<const M: usize>(a: &[[f64; M]; M]) -> [[f64; M]; M] {
+    let norm = (0..M)
+        .map(|j| (0..M).map(|i| a[i][j].abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    let mut squarings = 0;
+    let mut scale = 1.0;
+    while norm * scale > 0.5 {
+        scale *= 0.5;
+        squarings += 1;
+    }
+    let mut x = *a;
+    for row in x.iter_mut() {
+        for v in row.iter_mut() {
+            *v *= scale;
+        }
+    }
+    let mut result = [[0.0; M]; M];
+    let mut term = [[0.0; M]; M];
+    for i in 0..M {
+        result[i][i] = 1.0;
+        term[i][i] = 1.0;
+    }
+    for k in 1..=18 {
+        term = matmul(&term, &x);
+        for row in term.iter_mut() {
+            for v in row.iter_mut() {
+                *v /= k as f64;
+            }
+        }
+        for i in 0..M {
+            for j in 0..M {
+                result[i][j] += term[i][j];
+            }
+        }
+    }
+    for _ in 0..squarings {
+        result = matmul(&result, &result);
+    }
+    result
+}
+
+fn matmul<const M: usize>(a: &[[f64; M]; M], b: &[[f64; M]; M]) -> [[f64; M]; M] {
+    let mut c = [[0.0; M]; M];
+    for i in 0..M {
+        for k in 0..M {
+            let aik = a[i][k];
+            if aik == 0.0 {
+                continue;
+            }
+            for j in 0..M {
+                c[i][j] += aik * b[k][j];
+            }
+        }
+    }
+    c
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn expm_of_a_rotation_generator_is_the_rotation() {
+        let a = [[0.0, -2.0], [2.0, 0.0]];
+        let e = expm(&a);
+        assert!((e[0][0] - 2f64.cos()).abs() < 1e-14);
+        assert!((e[1][0] - 2f64.sin()).abs() < 1e-14);
+    }
+}
