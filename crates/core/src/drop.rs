@@ -194,6 +194,17 @@ fn next_mode(sys: &DropSystem, y: &[f64; N], index: usize) -> Mode {
     m
 }
 
+/// The scene's optional release state (offset, velocity, race spin) on top of the default
+/// release (rotor at the centre at rest, race at rest at its static sag). All zero by default,
+/// so the state is then exactly the MODEL-NOTES release.
+fn apply_release(scene: &Scene, y: &mut [f64; N]) {
+    y[ix::XR] += scene.release_offset_m[0];
+    y[ix::YR] += scene.release_offset_m[1];
+    y[ix::VXR] += scene.release_velocity_m_s[0];
+    y[ix::VYR] += scene.release_velocity_m_s[1];
+    y[ix::WB] += scene.race_speed_rad_s;
+}
+
 /// Simulates one drop of `scene` under `opts`.
 pub fn simulate(scene: &Scene, opts: &DropOptions) -> Result<DropReport, SolveError> {
     simulate_observed(scene, opts, &mut NoObserver)
@@ -210,6 +221,7 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
     opts.validate()?;
     let mut sys = DropSystem::new(scene);
     let mut y = sys.initial_state(scene.spin_rad_s());
+    apply_release(scene, &mut y);
     let e0 = sys.mechanical_energy(&y, sys.mode);
     let mut stepper = Dopri5::new(tolerances(scene, &sys));
     let mut mon = Monitor::new(

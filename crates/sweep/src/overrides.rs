@@ -56,8 +56,14 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
                 });
             }
         };
-        if !obj.contains_key(*part) {
-            let known = obj.keys().cloned().collect::<Vec<_>>().join(", ");
+        // Optional scene fields are absent from the JSON while at their default.
+        let optional = i == 0 && Scene::OPTIONAL_FIELDS.contains(part);
+        if !obj.contains_key(*part) && !optional {
+            let mut known = obj.keys().cloned().collect::<Vec<_>>();
+            if i == 0 {
+                known.extend(Scene::OPTIONAL_FIELDS.iter().map(|k| k.to_string()));
+            }
+            let known = known.join(", ");
             return Err(OverrideError::UnknownKey {
                 key: key.to_string(),
                 known,
@@ -94,6 +100,17 @@ mod tests {
         assert_eq!(s.mu_static, Some(0.4));
         apply_assignment(&mut s, "friction_law=switched").unwrap();
         assert_eq!(s.friction_law, FrictionLaw::Switched);
+        apply_assignment(&mut s, "release_offset_m=[1e-5, -2e-5]").unwrap();
+        apply_assignment(&mut s, "race_speed_rad_s=12.5").unwrap();
+        assert_eq!(s.release_offset_m, [1e-5, -2e-5]);
+        assert_eq!(s.race_speed_rad_s, 12.5);
+        let e = apply_assignment(&mut s, "race_sped=1")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("race_speed_rad_s"),
+            "optional keys are listed: {e}"
+        );
     }
 
     #[test]
