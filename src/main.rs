@@ -17,6 +17,7 @@ use whirlmap_sweep::render::{draw_orbit, ImageFormat};
 
 mod bench;
 mod critical_cmd;
+mod ensemble_cmd;
 mod render_cmd;
 mod sweep_cmd;
 
@@ -46,6 +47,12 @@ enum Command {
     Critical(critical_cmd::CriticalArgs),
     /// Run a grid of drops from a JSON sweep spec (exit 1 if any point failed).
     Sweep(sweep_cmd::SweepArgs),
+    /// Whirl probability per grid cell from seeded ensembles of drops, with probability
+    /// contours and Fig. 4 with bands (exit 1 if any drop failed).
+    Ensemble(ensemble_cmd::EnsembleArgs),
+    /// Adaptive refinement of the whirl boundary over speed x mu (`--compare-full` also runs
+    /// the full fine grid and reports the agreement).
+    Adaptive(ensemble_cmd::EnsembleArgs),
 }
 
 #[derive(clap::Args)]
@@ -225,6 +232,8 @@ fn main() -> ExitCode {
         }),
         Command::Critical(a) => critical_cmd::run(a),
         Command::Sweep(a) => return sweep_cmd::run(a),
+        Command::Ensemble(a) => return ensemble_cmd::run_ensemble_cmd(a),
+        Command::Adaptive(a) => return ensemble_cmd::run_adaptive_cmd(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

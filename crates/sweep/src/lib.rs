@@ -7,14 +7,20 @@
 //! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
 //!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
+//! - [`ensemble`]: whirl probability per cell (seeded ensembles of drops), probability
+//!   contours; [`prob_chart`]: Fig. 4 drawn with them; [`adaptive`]: adaptive refinement of
+//!   the whirl boundary.
 #![warn(missing_docs)]
 
+pub mod adaptive;
 pub mod charts;
 pub mod classify;
 pub mod critical;
+pub mod ensemble;
 pub mod extras;
 pub mod fonts;
 pub mod overrides;
+pub mod prob_chart;
 pub mod record;
 pub mod render;
 pub mod spec;
