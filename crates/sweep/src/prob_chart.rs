@@ -102,13 +102,14 @@ impl Figure for ProbabilityFigure<'_> {
         }
 
         let n_levels = self.contours.groups.first().map_or(0, |g| g.levels.len());
-        // The band between the lowest and the highest level, where both exist.
+        // The band between the lowest and the highest level; where the highest is not
+        // reached in the range, the band runs to the top of the chart.
         if n_levels >= 2 {
             let pts: Vec<(f64, f64, f64)> = groups
                 .iter()
                 .filter_map(|(m, g)| {
                     let a = g.levels.first()?.speed_rpm?;
-                    let b = g.levels.last()?.speed_rpm?;
+                    let b = g.levels.last()?.speed_rpm.unwrap_or(s_hi + pad_s);
                     Some((*m, a, b))
                 })
                 .collect();
@@ -150,8 +151,8 @@ impl Figure for ProbabilityFigure<'_> {
         }
 
         // Legend: one entry per level.
-        let style = chart_text_style(16.0);
-        let mut x = 110;
+        let style = chart_text_style(14.0);
+        let mut x = 60;
         for (k, l) in self
             .contours
             .groups
@@ -168,10 +169,10 @@ impl Figure for ProbabilityFigure<'_> {
             ))?;
             let text = format!("P(whirl) = {:.0} %", 100.0 * l.level);
             legend_band.draw_text(&text, &style, (x + 38, 11))?;
-            x += 200;
+            x += 175;
         }
         let text = format!(
-            "bars: {:.0} % Wilson intervals; dots: P per cell ({} drops)",
+            "bars: {:.0} % intervals; dots: P per cell ({} drops)",
             100.0 * self.contours.confidence,
             self.contours.members
         );
