@@ -20,6 +20,7 @@ mod accuracy_cmd;
 mod bench;
 mod compare_cmd;
 mod critical_cmd;
+mod ensemble_cmd;
 mod merge_cmd;
 mod render_cmd;
 mod shard_cmd;
@@ -61,6 +62,12 @@ enum Command {
     /// critical-speed shifts; a Markdown report with a class map (exit 0 same, 1 changed,
     /// 2 error).
     Compare(compare_cmd::CompareArgs),
+    /// Whirl probability per grid cell from seeded ensembles of drops, with probability
+    /// contours and Fig. 4 with bands (exit 1 if any drop failed).
+    Ensemble(ensemble_cmd::EnsembleArgs),
+    /// Adaptive refinement of the whirl boundary over speed x mu (`--compare-full` also runs
+    /// the full fine grid and reports the agreement).
+    Adaptive(ensemble_cmd::EnsembleArgs),
 }
 
 #[derive(clap::Args)]
@@ -316,6 +323,8 @@ fn main() -> ExitCode {
         Command::Accuracy(a) => accuracy_cmd::run_cmd(a),
         Command::Merge(a) => return merge_cmd::run(a),
         Command::Compare(a) => return compare_cmd::run(a),
+        Command::Ensemble(a) => return ensemble_cmd::run_ensemble_cmd(a),
+        Command::Adaptive(a) => return ensemble_cmd::run_adaptive_cmd(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

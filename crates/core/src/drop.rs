@@ -230,6 +230,17 @@ pub(crate) fn next_mode(sys: &DropSystem, y: &[f64; N], index: usize) -> Mode {
     m
 }
 
+/// The scene's optional release state (offset, velocity, race spin) on top of the default
+/// release (rotor at the centre at rest, race at rest at its static sag). All zero by default,
+/// so the state is then exactly the MODEL-NOTES release.
+fn apply_release(scene: &Scene, y: &mut [f64; N]) {
+    y[ix::XR] += scene.release_offset_m[0];
+    y[ix::YR] += scene.release_offset_m[1];
+    y[ix::VXR] += scene.release_velocity_m_s[0];
+    y[ix::VYR] += scene.release_velocity_m_s[1];
+    y[ix::WB] += scene.race_speed_rad_s;
+}
+
 /// Simulates one drop of `scene` under `opts`.
 pub fn simulate(scene: &Scene, opts: &DropOptions) -> Result<DropReport, SolveError> {
     simulate_observed(scene, opts, &mut NoObserver)
@@ -261,6 +272,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
     mut stepper: M,
 ) -> Result<DropReport, SolveError> {
     let mut y = sys.initial_state(scene.spin_rad_s());
+    apply_release(scene, &mut y);
     let e0 = sys.mechanical_energy(&y, sys.mode);
     let mut mon = Monitor::new(
         opts.duration_s,

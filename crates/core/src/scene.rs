@@ -121,6 +121,23 @@ pub struct Scene {
     /// Angle of the unbalance at release, from +x, counter-clockwise (rad). Default 0.
     pub unbalance_phase_rad: f64,
 
+    // ---- release state (issue 7: what a real drop does not control) ----------------------
+    // Optional: left out of the JSON (and so of the scene hash) while at their defaults, so
+    // scenes without them keep their hash and records. See [`Scene::OPTIONAL_FIELDS`].
+    /// Rotor geometric centre at release, relative to the housing (race) centre (m).
+    /// Default [0, 0] (MODEL-NOTES: released at the centre). Allowed: magnitude at most
+    /// 0.9 * clearance_m, so the release is clear of the race.
+    #[serde(skip_serializing_if = "is_zero2")]
+    pub release_offset_m: [f64; 2],
+    /// Rotor geometric centre velocity at release (m/s), e.g. the AMB orbit's. Default
+    /// [0, 0]. Allowed: magnitude at most 100 m/s.
+    #[serde(skip_serializing_if = "is_zero2")]
+    pub release_velocity_m_s: [f64; 2],
+    /// Inner race spin at release (rad/s), counter-clockwise positive. Default 0 (at rest).
+    /// Allowed |value| <= 1e5 rad/s.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub race_speed_rad_s: f64,
+
     // ---- inner race (Tables 2, 4) ------------------------------------------------------
     /// Inner race mass (kg). Table 2: 0.048.
     pub race_mass_kg: f64,
@@ -199,7 +216,26 @@ impl Default for Scene {
 /// 2.47e5 N/mm^1.5 in N/m^1.5: 1 N/mm^1.5 = 1000^1.5 N/m^1.5.
 const K2_TABLE4_N_PER_M15: f64 = 2.47e5 * 31_622.776_601_683_792;
 
+// Exact comparisons on purpose: only the default (zero) is left out of the JSON.
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+fn is_zero2(v: &[f64; 2]) -> bool {
+    is_zero(&v[0]) && is_zero(&v[1])
+}
+
 impl Scene {
+    /// Fields left out of the serialised scene while at their default (so adding them did
+    /// not change existing scene hashes); settable by name all the same.
+    pub const OPTIONAL_FIELDS: &'static [&'static str] = &[
+        "release_offset_m",
+        "release_velocity_m_s",
+        "race_speed_rad_s",
+        "quasi_static_race",
+        "stop_speed_rpm",
+        "thermal",
+    ];
+
     /// The paper's scene: Tables 2-4 with the MODEL-NOTES defaults, 8000 r/min, mu 0.1.
     pub fn paper() -> Self {
         Self {
@@ -214,6 +250,9 @@ impl Scene {
             rotor_diameter_m: 39.7e-3,
             unbalance_m: 0.0,
             unbalance_phase_rad: 0.0,
+            release_offset_m: [0.0; 2],
+            release_velocity_m_s: [0.0; 2],
+            race_speed_rad_s: 0.0,
             race_mass_kg: 0.048,
             race_polar_moi_kg_m2: 2.33e-5,
             clearance_m: 0.15e-3,
@@ -342,6 +381,26 @@ impl Scene {
             self.unbalance_phase_rad,
             true,
             "finite",
+        )?;
+        let [ox, oy] = self.release_offset_m;
+        check(
+            "release_offset_m",
+            ox.hypot(oy),
+            ox.hypot(oy) <= 0.9 * self.clearance_m,
+            "magnitude [0, 0.9 * clearance_m] m",
+        )?;
+        let [vx, vy] = self.release_velocity_m_s;
+        check(
+            "release_velocity_m_s",
+            vx.hypot(vy),
+            vx.hypot(vy) <= 100.0,
+            "magnitude [0, 100] m/s",
+        )?;
+        check(
+            "race_speed_rad_s",
+            self.race_speed_rad_s,
+            self.race_speed_rad_s.abs() <= 1e5,
+            "[-1e5, 1e5] rad/s",
         )?;
         check(
             "race_mass_kg",

@@ -1489,9 +1489,16 @@ pub fn draw_marked_class_map(
 
 /// Draws every chart whose data exists in the results directory `dir` into `dir/charts/`, as
 /// PNG and SVG: `fig5_max_force`, `fig6_peak_power` and `classes` from `points.jsonl`
-/// (required), `peak_temperature` if the records carry temperatures, `fig4_critical` if `critical.json` exists, `fig3_orbits` if `orbits/` holds
-/// orbit files. Returns the paths written, in that order.
+/// (required), `peak_temperature` if the records carry temperatures, `fig4_critical` if
+/// `critical.json` exists, `fig3_orbits` if `orbits/` holds orbit files, `fig4_probability` if
+/// `contours.json` (an ensemble's) exists (then `points.jsonl` is optional). Returns the paths
+/// written.
 pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
+    // An ensemble's results (issue 7): Fig. 4 with probability bands.
+    let prob = crate::prob_chart::render_probability(dir)?;
+    if !prob.is_empty() && !dir.join(crate::sweep::POINTS_FILE).exists() {
+        return Ok(prob);
+    }
     let rows = load_points(dir)?;
     let critical = load_critical(dir)?;
     let orbits = load_orbits(dir)?;
@@ -1569,6 +1576,7 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
             &mut written,
         )?;
     }
+    written.extend(prob);
     Ok(written)
 }
 

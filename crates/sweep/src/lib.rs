@@ -11,19 +11,25 @@
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
 //! - [`accuracy`] and [`accuracy_chart`]: the work-precision study (`whirlmap accuracy`).
 //! - [`thermal_chart`]: node temperatures and thermal load of one thermal drop over time.
+//! - [`ensemble`]: whirl probability per cell (seeded ensembles of drops), probability
+//!   contours; [`prob_chart`]: Fig. 4 drawn with them; [`adaptive`]: adaptive refinement of
+//!   the whirl boundary.
 #![warn(missing_docs)]
 
 pub mod accuracy;
 pub mod accuracy_chart;
+pub mod adaptive;
 pub mod charts;
 pub mod classify;
 pub mod compare;
 pub mod critical;
+pub mod ensemble;
 pub mod extras;
 pub mod extremes;
 pub mod fonts;
 pub mod merge;
 pub mod overrides;
+pub mod prob_chart;
 pub mod recheck;
 pub mod record;
 pub mod render;

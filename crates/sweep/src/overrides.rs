@@ -46,6 +46,12 @@ pub fn apply_assignment(scene: &mut Scene, assignment: &str) -> Result<(), Overr
 fn show_optional_fields(root: &mut Value) {
     if let Value::Object(m) = root {
         m.entry("quasi_static_race").or_insert(Value::Bool(false));
+        m.entry("stop_speed_rpm").or_insert(Value::Null);
+        for key in ["release_offset_m", "release_velocity_m_s"] {
+            m.entry(key).or_insert(serde_json::json!([0.0, 0.0]));
+        }
+        m.entry("race_speed_rad_s")
+            .or_insert(serde_json::json!(0.0));
         if let Some(Value::Object(solver)) = m.get_mut("solver") {
             solver
                 .entry("method")
@@ -70,8 +76,14 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
                 });
             }
         };
-        if !obj.contains_key(*part) {
-            let known = obj.keys().cloned().collect::<Vec<_>>().join(", ");
+        // Optional scene fields are absent from the JSON while at their default.
+        let optional = i == 0 && Scene::OPTIONAL_FIELDS.contains(part);
+        if !obj.contains_key(*part) && !optional {
+            let mut known = obj.keys().cloned().collect::<Vec<_>>();
+            if i == 0 {
+                known.extend(Scene::OPTIONAL_FIELDS.iter().map(|k| k.to_string()));
+            }
+            let known = known.join(", ");
             return Err(OverrideError::UnknownKey {
                 key: key.to_string(),
                 known,
@@ -81,7 +93,15 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
             obj.insert(part.to_string(), value.clone());
             break;
         }
-        node = obj.get_mut(*part).expect("checked above");
+        // An optional section that is absent (e.g. `thermal` on a drop without it) has no
+        // sub-keys to set: say so instead of failing deeper.
+        let Some(next) = obj.get_mut(*part) else {
+            return Err(OverrideError::UnknownKey {
+                key: key.to_string(),
+                known: format!("(`{part}` is not set in this scene; set it whole first)"),
+            });
+        };
+        node = next;
     }
     *scene = serde_json::from_value(root).map_err(|e| OverrideError::BadValue {
         key: key.to_string(),
@@ -94,6 +114,22 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
 mod tests {
     use super::*;
     use whirlmap_core::FrictionLaw;
+
+    #[test]
+    fn optional_fields_are_settable_and_absent_sections_are_an_error_not_a_panic() {
+        let mut s = Scene::paper();
+        apply_assignment(&mut s, "stop_speed_rpm=1000").unwrap();
+        assert_eq!(s.stop_speed_rpm, Some(1000.0));
+        apply_assignment(&mut s, "race_speed_rad_s=5").unwrap();
+        assert_eq!(s.race_speed_rad_s, 5.0);
+        apply_assignment(&mut s, "quasi_static_race=true").unwrap();
+        assert!(s.quasi_static_race);
+        let err = apply_assignment(&mut s, "thermal.macro_step_s=0.01").unwrap_err();
+        assert!(err.to_string().contains("thermal"), "{err}");
+        apply_assignment(&mut s, "thermal={}").unwrap();
+        apply_assignment(&mut s, "thermal.macro_step_s=0.002").unwrap();
+        assert_eq!(s.thermal.as_ref().unwrap().macro_step_s, 0.002);
+    }
 
     #[test]
     fn sets_flat_nested_and_enum_fields() {
@@ -119,6 +155,17 @@ mod tests {
         assert_eq!(s.mu_static, Some(0.4));
         apply_assignment(&mut s, "friction_law=switched").unwrap();
         assert_eq!(s.friction_law, FrictionLaw::Switched);
+        apply_assignment(&mut s, "release_offset_m=[1e-5, -2e-5]").unwrap();
+        apply_assignment(&mut s, "race_speed_rad_s=12.5").unwrap();
+        assert_eq!(s.release_offset_m, [1e-5, -2e-5]);
+        assert_eq!(s.race_speed_rad_s, 12.5);
+        let e = apply_assignment(&mut s, "race_sped=1")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("race_speed_rad_s"),
+            "optional keys are listed: {e}"
+        );
     }
 
     #[test]

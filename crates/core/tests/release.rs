@@ -1,0 +1,99 @@
+//! The optional release state (issue 7): rotor offset and velocity, race spin at release.
+//! Defaults reproduce the MODEL-NOTES release exactly; non-defaults are tested by physics.
+
+use whirlmap_core::{simulate, DropOptions, Scene};
+
+#[test]
+fn default_release_fields_are_left_out_of_the_json_and_the_hash() {
+    let s = Scene::paper();
+    let text = serde_json::to_string(&s).unwrap();
+    for key in Scene::OPTIONAL_FIELDS {
+        assert!(
+            !text.contains(key),
+            "{key} must not be serialised at its default"
+        );
+    }
+    let mut t = s.clone();
+    t.race_speed_rad_s = 1.0;
+    t.release_offset_m = [1e-6, 0.0];
+    t.release_velocity_m_s = [0.0, -1e-3];
+    let text = serde_json::to_string(&t).unwrap();
+    assert!(text.contains("\"race_speed_rad_s\":1.0"), "{text}");
+    assert_eq!(serde_json::from_str::<Scene>(&text).unwrap(), t);
+    assert_ne!(s.hash_hex(), t.hash_hex());
+}
+
+#[test]
+fn release_fields_are_validated_by_name() {
+    let mut s = Scene::paper();
+    s.release_offset_m = [0.0, -0.95 * s.clearance_m];
+    assert_eq!(s.validate().unwrap_err().field, "release_offset_m");
+    s.release_offset_m = [0.0, -0.85 * s.clearance_m];
+    s.validate().unwrap();
+    s.release_velocity_m_s = [f64::NAN, 0.0];
+    assert_eq!(s.validate().unwrap_err().field, "release_velocity_m_s");
+    s.release_velocity_m_s = [0.0, 0.0];
+    s.race_speed_rad_s = 2e5;
+    let e = s.validate().unwrap_err();
+    assert_eq!(e.field, "race_speed_rad_s");
+    assert!(e.to_string().contains("1e5"), "{e}");
+}
+
+/// Without gravity and far from the race, the rotor centre moves in a straight line at its
+/// release velocity, and the race keeps its release spin when drag is off (no torque on it).
+#[test]
+fn free_flight_from_an_offset_release_is_a_straight_line() {
+    let mut s = Scene::paper();
+    s.gravity_m_s2 = 0.0;
+    s.drag_enabled = false;
+    s.release_offset_m = [20e-6, -10e-6];
+    s.release_velocity_m_s = [1e-3, 2e-3];
+    s.race_speed_rad_s = 50.0;
+    let t = 0.02; // 20-40 um travel: stays clear of the 150 um clearance
+    let r = simulate(
+        &s,
+        &DropOptions {
+            duration_s: t,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let y = r.final_state;
+    assert!(
+        (y[whirlmap_core::model::ix::XR] - (20e-6 + 1e-3 * t)).abs() < 1e-12,
+        "x = {}",
+        y[0]
+    );
+    assert!(
+        (y[whirlmap_core::model::ix::YR] - (-10e-6 + 2e-3 * t)).abs() < 1e-12,
+        "y = {}",
+        y[1]
+    );
+    assert!(
+        (y[whirlmap_core::model::ix::WB] - 50.0).abs() < 1e-9,
+        "race spin {}",
+        y[11]
+    );
+    assert_eq!(r.features.impacts, 0);
+}
+
+/// A release with velocity and race spin still closes the energy audit (the initial energy
+/// includes the release kinetic energy).
+#[test]
+fn energy_audit_closes_with_a_moving_release() {
+    let mut s = Scene::paper();
+    s.mu_dynamic = 0.2;
+    s.release_offset_m = [30e-6, 10e-6];
+    s.release_velocity_m_s = [-0.02, 0.01];
+    s.race_speed_rad_s = 100.0;
+    let r = simulate(
+        &s,
+        &DropOptions {
+            duration_s: 0.03,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(r.features.impacts > 0);
+    assert!(r.energy.residual_rel < 1e-6, "{:?}", r.energy);
+}

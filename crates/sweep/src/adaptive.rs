@@ -1,0 +1,706 @@
+//! Adaptive refinement of the whirl boundary over (speed, mu): instead of every point of a
+//! fine grid, a coarse seed grid whose cells are split where the boundary runs.
+//!
+//! ## Algorithm ([`refine`], generic over the evaluation)
+//! The fine grid (the `speed_rpm` and `mu` axes of the file) fixes the smallest cell. Seed
+//! points are spread evenly over its indices. A cell is refined when its corners disagree:
+//! each corner's value (P(whirl), or 0/1 for single drops) falls in a bin, "safe" (<= the
+//! lower bound), "whirl" (>= the upper bound) or "uncertain" (between); a cell is split
+//! unless all four corners share the safe or the whirl bin. Splitting is at the integer
+//! midpoints of its index ranges (only along ranges wider than one fine step), so every
+//! corner is a fine-grid point. Rounds continue until no cell can split; a refined 1 x 1
+//! cell is a boundary cell. Every round's new corners are evaluated as one batch in index
+//! order and cached, so no corner is evaluated twice and the order (and the result) is
+//! deterministic. Failed evaluations (NaN) count as uncertain.
+//!
+//! Every fine point not evaluated lies in a leaf whose corners agree, and takes their value
+//! ([`Refinement::inferred`]). The known blind spot of corner tests: a boundary that enters
+//! and leaves a seed cell through the same edge, or an island smaller than a seed cell, is
+//! not seen. The seed grid must be fine enough for the features sought.
+//!
+//! ## Use
+//! `whirlmap adaptive FILE [--compare-full]`: the file is an ensemble file
+//! ([`crate::ensemble`]) with exactly the axes `speed_rpm` and `mu` and an `adaptive`
+//! section ([`AdaptiveParams`]); with an `ensemble` section each corner is an ensemble and
+//! its value P(whirl), else one drop (whirl 1, else 0). `--compare-full` also evaluates
+//! every fine point (reusing the corners already run: same inputs, same result) and reports
+//! how far the boundaries lie apart.
+
+use crate::ensemble::{self, first_crossing, Cell, EnsembleSpec};
+use crate::spec::{check_output_dir, SpecError};
+use crate::sweep::{run_case, SweepError};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Output file of `whirlmap adaptive`.
+pub const ADAPTIVE_FILE: &str = "adaptive.json";
+
+fn default_bounds() -> [f64; 2] {
+    [0.1, 0.9]
+}
+
+/// The `adaptive` section of an ensemble file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AdaptiveParams {
+    /// Seed grid points along the speed axis, [2, points of the axis].
+    pub seed_speed_points: usize,
+    /// Seed grid points along the mu axis, [2, points of the axis].
+    pub seed_mu_points: usize,
+    /// P(whirl) at or below the first is safe, at or above the second whirl; between is
+    /// uncertain (always refined). Default [0.1, 0.9]; 0 < lower <= upper < 1. Single drops
+    /// give 0 or 1, so then only disagreeing corners refine.
+    #[serde(default = "default_bounds")]
+    pub p_bounds: [f64; 2],
+}
+
+impl AdaptiveParams {
+    /// Checks the section against the file's axes (exactly `speed_rpm` and `mu`).
+    pub fn validate(&self, spec: &EnsembleSpec) -> Result<(), SpecError> {
+        let bad = |field: &str, value: String, allowed: String| {
+            Err(SpecError::Invalid {
+                field: field.into(),
+                value,
+                allowed,
+            })
+        };
+        let names: Vec<&str> = spec.axes.0.iter().map(|a| a.name.as_str()).collect();
+        if names.len() != 2 || !names.contains(&"speed_rpm") || !names.contains(&"mu") {
+            return bad(
+                "axes",
+                names.join(", "),
+                "exactly speed_rpm and mu for an adaptive search".into(),
+            );
+        }
+        let (speeds, mus) = fine_axes(spec);
+        for (field, n, len) in [
+            (
+                "adaptive.seed_speed_points",
+                self.seed_speed_points,
+                speeds.len(),
+            ),
+            ("adaptive.seed_mu_points", self.seed_mu_points, mus.len()),
+        ] {
+            if len < 2 {
+                return bad(
+                    field,
+                    n.to_string(),
+                    format!("an axis of at least 2 points (it has {len})"),
+                );
+            }
+            if n < 2 || n > len {
+                return bad(
+                    field,
+                    n.to_string(),
+                    format!("[2, {len}] (the axis's points)"),
+                );
+            }
+        }
+        let [lo, hi] = self.p_bounds;
+        if !(lo > 0.0 && lo <= hi && hi < 1.0) {
+            return bad(
+                "adaptive.p_bounds",
+                format!("[{lo}, {hi}]"),
+                "0 < lower <= upper < 1".into(),
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The fine speed and mu values of an adaptive file (axis values in file order).
+fn fine_axes(spec: &EnsembleSpec) -> (Vec<f64>, Vec<f64>) {
+    let get = |n: &str| {
+        spec.axes
+            .0
+            .iter()
+            .find(|a| a.name == n)
+            .map(|a| a.values.values())
+            .unwrap_or_default()
+    };
+    (get("speed_rpm"), get("mu"))
+}
+
+/// A final cell of the refinement: fine-grid index ranges (inclusive) along speed (`i`) and
+/// mu (`j`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Leaf {
+    /// First speed index.
+    pub i0: usize,
+    /// Last speed index.
+    pub i1: usize,
+    /// First mu index.
+    pub j0: usize,
+    /// Last mu index.
+    pub j1: usize,
+    /// Its corners disagree (a refined cell of the smallest size).
+    pub boundary: bool,
+}
+
+impl Leaf {
+    fn corners(&self) -> [(usize, usize); 4] {
+        [
+            (self.i0, self.j0),
+            (self.i1, self.j0),
+            (self.i0, self.j1),
+            (self.i1, self.j1),
+        ]
+    }
+    fn contains(&self, i: usize, j: usize) -> bool {
+        (self.i0..=self.i1).contains(&i) && (self.j0..=self.j1).contains(&j)
+    }
+}
+
+/// The result of [`refine`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refinement {
+    /// Fine grid points along speed and mu.
+    pub shape: (usize, usize),
+    /// Every evaluated point: (speed index, mu index) -> value.
+    pub values: BTreeMap<(usize, usize), f64>,
+    /// The final cells.
+    pub leaves: Vec<Leaf>,
+    /// Refinement rounds after the seed grid.
+    pub rounds: usize,
+}
+
+/// `n` indices spread evenly over `0..len` (both ends included), without repeats.
+fn spread(len: usize, n: usize) -> Vec<usize> {
+    let n = n.clamp(2, len.max(2));
+    let mut v: Vec<usize> = (0..n)
+        .map(|k| ((k * (len - 1)) as f64 / (n - 1) as f64).round() as usize)
+        .collect();
+    v.dedup();
+    v
+}
+
+/// 0 safe, 1 uncertain (or failed), 2 whirl.
+fn bin(v: f64, [lo, hi]: [f64; 2]) -> u8 {
+    if v <= lo {
+        0
+    } else if v >= hi {
+        2
+    } else {
+        1 // also NaN
+    }
+}
+
+/// Evaluates a batch of fine points (speed index, mu index), in index order, to one value
+/// each in the same order.
+pub type BatchEval<'a> = dyn FnMut(&[(usize, usize)]) -> Vec<f64> + 'a;
+
+/// Refines the fine grid of `shape` (points along speed, mu; each >= 2) from a seed grid of
+/// `seed` points, evaluating corners with `eval` (a batch of (i, j) in index order -> one
+/// value each, in the same order). See the module doc.
+pub fn refine(
+    shape: (usize, usize),
+    seed: (usize, usize),
+    bounds: [f64; 2],
+    eval: &mut BatchEval<'_>,
+) -> Refinement {
+    let (nx, ny) = shape;
+    let mut values: BTreeMap<(usize, usize), f64> = BTreeMap::new();
+    let mut evaluate = |cells: &[Leaf], values: &mut BTreeMap<(usize, usize), f64>| {
+        let mut todo: Vec<(usize, usize)> = cells
+            .iter()
+            .flat_map(|c| c.corners())
+            .filter(|p| !values.contains_key(p))
+            .collect();
+        todo.sort_unstable();
+        todo.dedup();
+        if !todo.is_empty() {
+            let got = eval(&todo);
+            for (p, v) in todo.into_iter().zip(got) {
+                values.insert(p, v);
+            }
+        }
+    };
+    let xs = spread(nx, seed.0);
+    let ys = spread(ny, seed.1);
+    let mut cells: Vec<Leaf> = xs
+        .windows(2)
+        .flat_map(|x| {
+            ys.windows(2).map(move |y| Leaf {
+                i0: x[0],
+                i1: x[1],
+                j0: y[0],
+                j1: y[1],
+                boundary: false,
+            })
+        })
+        .collect();
+    evaluate(&cells, &mut values);
+    let mut leaves = Vec::new();
+    let mut rounds = 0;
+    loop {
+        let mut next = Vec::new();
+        for c in &cells {
+            let b: Vec<u8> = c.corners().iter().map(|p| bin(values[p], bounds)).collect();
+            let agree = b[0] != 1 && b.iter().all(|x| *x == b[0]);
+            if agree {
+                leaves.push(*c);
+                continue;
+            }
+            let split_i = c.i1 - c.i0 > 1;
+            let split_j = c.j1 - c.j0 > 1;
+            if !split_i && !split_j {
+                leaves.push(Leaf {
+                    boundary: true,
+                    ..*c
+                });
+                continue;
+            }
+            let is = if split_i {
+                vec![(c.i0, (c.i0 + c.i1) / 2), ((c.i0 + c.i1) / 2, c.i1)]
+            } else {
+                vec![(c.i0, c.i1)]
+            };
+            let js = if split_j {
+                vec![(c.j0, (c.j0 + c.j1) / 2), ((c.j0 + c.j1) / 2, c.j1)]
+            } else {
+                vec![(c.j0, c.j1)]
+            };
+            for &(i0, i1) in &is {
+                for &(j0, j1) in &js {
+                    next.push(Leaf {
+                        i0,
+                        i1,
+                        j0,
+                        j1,
+                        boundary: false,
+                    });
+                }
+            }
+        }
+        if next.is_empty() {
+            break;
+        }
+        rounds += 1;
+        evaluate(&next, &mut values);
+        cells = next;
+    }
+    leaves.sort_by_key(|l| (l.i0, l.j0, l.i1, l.j1));
+    Refinement {
+        shape,
+        values,
+        leaves,
+        rounds,
+    }
+}
+
+impl Refinement {
+    /// The value at every fine point, row-major `[i * ny + j]`: evaluated, or the mean of the
+    /// corners of the first leaf (in index order) that holds it.
+    pub fn inferred(&self) -> Vec<f64> {
+        let (nx, ny) = self.shape;
+        let mut out = vec![f64::NAN; nx * ny];
+        for i in 0..nx {
+            for j in 0..ny {
+                out[i * ny + j] = match self.values.get(&(i, j)) {
+                    Some(v) => *v,
+                    None => self
+                        .leaves
+                        .iter()
+                        .find(|l| l.contains(i, j))
+                        .map(|l| l.corners().iter().map(|p| self.values[p]).sum::<f64>() / 4.0)
+                        .unwrap_or(f64::NAN),
+                };
+            }
+        }
+        out
+    }
+}
+
+/// The boundary of a row-major map `[i * ny + j]` at `level`: for each mu index `j`, the
+/// first speed (as a fractional speed index) where the value reaches `level`, linear between
+/// points; `None` if it never does or already does at index 0.
+pub fn boundary(map: &[f64], shape: (usize, usize), level: f64) -> Vec<Option<f64>> {
+    let (nx, ny) = shape;
+    let idx: Vec<f64> = (0..nx).map(|i| i as f64).collect();
+    (0..ny)
+        .map(|j| {
+            let col: Vec<f64> = (0..nx).map(|i| map[i * ny + j]).collect();
+            first_crossing(&idx, &col, level).ok()
+        })
+        .collect()
+}
+
+/// How two boundaries (from [`boundary`]) agree.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Agreement {
+    /// Largest distance between the two crossings over the columns where both have one, in
+    /// fine speed steps.
+    pub max_shift_cells: f64,
+    /// Columns where one has a crossing and the other not.
+    pub columns_differing: usize,
+    /// Fine points whose bin (safe, uncertain, whirl) differs between the two maps.
+    pub points_differing: usize,
+}
+
+/// Compares an inferred map with the full one at `level` (and `bounds` for the bins).
+pub fn agreement(
+    inferred: &[f64],
+    full: &[f64],
+    shape: (usize, usize),
+    level: f64,
+    bounds: [f64; 2],
+) -> Agreement {
+    let a = boundary(inferred, shape, level);
+    let b = boundary(full, shape, level);
+    let mut max_shift: f64 = 0.0;
+    let mut columns_differing = 0;
+    for (x, y) in a.iter().zip(&b) {
+        match (x, y) {
+            (Some(x), Some(y)) => max_shift = max_shift.max((x - y).abs()),
+            (None, None) => {}
+            _ => columns_differing += 1,
+        }
+    }
+    let points_differing = inferred
+        .iter()
+        .zip(full)
+        .filter(|(x, y)| bin(**x, bounds) != bin(**y, bounds))
+        .count();
+    Agreement {
+        max_shift_cells: max_shift,
+        columns_differing,
+        points_differing,
+    }
+}
+
+/// One evaluated corner in `adaptive.json`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Corner {
+    /// Release speed (r/min).
+    pub speed_rpm: f64,
+    /// Friction coefficient.
+    pub mu: f64,
+    /// P(whirl) (single drops: 1 whirl, 0 not; null failed).
+    pub p_whirl: f64,
+}
+
+/// The boundary at one mu.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BoundaryPoint {
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Where P(whirl) first reaches 1/2 along speed in the adaptive map (r/min).
+    pub speed_rpm: Option<f64>,
+    /// The same in the full grid (with `--compare-full`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub full_speed_rpm: Option<Option<f64>>,
+}
+
+/// The full-grid comparison of `adaptive.json`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Comparison {
+    /// Drops of the full fine grid.
+    pub full_grid_drops: usize,
+    /// How the boundaries agree.
+    pub agreement: Agreement,
+}
+
+/// The contents of `adaptive.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AdaptiveReport {
+    /// Spec name.
+    pub name: String,
+    /// Fine grid points along speed and mu.
+    pub fine_points: (usize, usize),
+    /// Seed grid points along speed and mu.
+    pub seed_points: (usize, usize),
+    /// The bins' bounds.
+    pub p_bounds: [f64; 2],
+    /// Drops per corner (1, or the ensemble's members).
+    pub drops_per_corner: usize,
+    /// Refinement rounds after the seed grid.
+    pub rounds: usize,
+    /// Corners evaluated.
+    pub corners: usize,
+    /// Drops the adaptive search used.
+    pub drops_used: usize,
+    /// Drops of the full fine grid it replaces.
+    pub full_grid_drops: usize,
+    /// `drops_used / full_grid_drops`.
+    pub drops_ratio: f64,
+    /// Boundary cells (refined to the smallest size).
+    pub boundary_cells: usize,
+    /// Per mu, the 50 % crossing along speed.
+    pub boundary: Vec<BoundaryPoint>,
+    /// With `--compare-full`: the full grid's drops and the agreement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub comparison: Option<Comparison>,
+    /// Every evaluated corner, in index order.
+    pub evaluated: Vec<Corner>,
+}
+
+/// Evaluates fine points: one drop each (whirl 1, not 0, failed NaN), or an ensemble each
+/// (P(whirl)); parallel, results in input order.
+fn evaluate_points(spec: &EnsembleSpec, cells: &[&Cell]) -> Vec<f64> {
+    match &spec.ensemble {
+        None => cells
+            .par_iter()
+            .map(|c| {
+                let point = crate::spec::Point {
+                    index: c.index,
+                    inputs: c.inputs.0.clone(),
+                    scene: c.scene.clone(),
+                };
+                match run_case(&point, spec.duration_s).record {
+                    Some(r) if r.class.is_whirl() => 1.0,
+                    Some(_) => 0.0,
+                    None => f64::NAN,
+                }
+            })
+            .collect(),
+        Some(params) => {
+            let owned: Vec<Cell> = cells.iter().map(|c| (*c).clone()).collect();
+            let members = ensemble::run_members(params, &owned, spec.duration_s, &mut |_, _| {});
+            members
+                .chunks(params.members)
+                .zip(&owned)
+                .map(|(ms, c)| ensemble::cell_stats(c.index, &c.inputs, ms, 1.96).p_whirl)
+                .collect()
+        }
+    }
+}
+
+/// Runs the adaptive search of `spec` (and, with `compare_full`, the full grid) and writes
+/// `adaptive.json` to `out_dir`.
+pub fn run_adaptive(
+    spec: &EnsembleSpec,
+    out_dir: &Path,
+    threads: Option<usize>,
+    compare_full: bool,
+    show_progress: bool,
+) -> Result<(AdaptiveReport, PathBuf), SweepError> {
+    let cells = spec.cells()?;
+    let params = spec.adaptive.clone().ok_or_else(|| SpecError::Invalid {
+        field: "adaptive".into(),
+        value: "(missing)".into(),
+        allowed: "an adaptive section".into(),
+    })?;
+    check_output_dir(out_dir)?;
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        builder = builder.num_threads(n);
+    }
+    let pool = builder
+        .build()
+        .map_err(|e| SweepError::ThreadPool(e.to_string()))?;
+    let (speeds, mus) = fine_axes(spec);
+    let shape = (speeds.len(), mus.len());
+    let speed_first = spec.axes.0[0].name == "speed_rpm";
+    let cell_at = |(i, j): (usize, usize)| {
+        let k = if speed_first {
+            i * shape.1 + j
+        } else {
+            j * shape.0 + i
+        };
+        &cells[k]
+    };
+    let start = Instant::now();
+    let mut done = 0usize;
+    let mut eval = |pts: &[(usize, usize)]| {
+        let batch: Vec<&Cell> = pts.iter().map(|p| cell_at(*p)).collect();
+        let v = pool.install(|| evaluate_points(spec, &batch));
+        done += pts.len();
+        if show_progress {
+            eprintln!(
+                "adaptive {}: {done} corners evaluated, {:.0} s",
+                spec.name,
+                start.elapsed().as_secs_f64()
+            );
+        }
+        v
+    };
+    let r = refine(
+        shape,
+        (params.seed_speed_points, params.seed_mu_points),
+        params.p_bounds,
+        &mut eval,
+    );
+    let per_corner = spec.ensemble.as_ref().map_or(1, |e| e.members);
+    let inferred = r.inferred();
+    let adaptive_b = boundary(&inferred, shape, 0.5);
+    let at_speed = |x: Option<f64>| {
+        x.map(|f| {
+            let i = (f.floor() as usize).min(shape.0 - 2);
+            speeds[i] + (f - i as f64) * (speeds[i + 1] - speeds[i])
+        })
+    };
+    let mut full_b = None;
+    let comparison = if compare_full {
+        let mut all = r.values.clone();
+        let missing: Vec<(usize, usize)> = (0..shape.0)
+            .flat_map(|i| (0..shape.1).map(move |j| (i, j)))
+            .filter(|p| !all.contains_key(p))
+            .collect();
+        for (p, v) in missing.iter().zip(eval(&missing)) {
+            all.insert(*p, v);
+        }
+        let full: Vec<f64> = all.values().copied().collect(); // BTreeMap: (i, j) order
+        full_b = Some(boundary(&full, shape, 0.5));
+        Some(Comparison {
+            full_grid_drops: shape.0 * shape.1 * per_corner,
+            agreement: agreement(&inferred, &full, shape, 0.5, params.p_bounds),
+        })
+    } else {
+        None
+    };
+    let full_grid_drops = shape.0 * shape.1 * per_corner;
+    let drops_used = r.values.len() * per_corner;
+    let report = AdaptiveReport {
+        name: spec.name.clone(),
+        fine_points: shape,
+        seed_points: (params.seed_speed_points, params.seed_mu_points),
+        p_bounds: params.p_bounds,
+        drops_per_corner: per_corner,
+        rounds: r.rounds,
+        corners: r.values.len(),
+        drops_used,
+        full_grid_drops,
+        drops_ratio: drops_used as f64 / full_grid_drops as f64,
+        boundary_cells: r.leaves.iter().filter(|l| l.boundary).count(),
+        boundary: mus
+            .iter()
+            .enumerate()
+            .map(|(j, &mu)| BoundaryPoint {
+                mu,
+                speed_rpm: at_speed(adaptive_b[j]),
+                full_speed_rpm: full_b.as_ref().map(|b: &Vec<Option<f64>>| at_speed(b[j])),
+            })
+            .collect(),
+        comparison,
+        evaluated: r
+            .values
+            .iter()
+            .map(|(&(i, j), &p)| Corner {
+                speed_rpm: speeds[i],
+                mu: mus[j],
+                p_whirl: p,
+            })
+            .collect(),
+    };
+    let path = out_dir.join(ADAPTIVE_FILE);
+    let text = serde_json::to_string_pretty(&report).expect("report serialises");
+    std::fs::write(&path, format!("{text}\n")).map_err(|source| SweepError::Io {
+        path: path.clone(),
+        source,
+    })?;
+    Ok((report, path))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Evaluates a synthetic map and counts the evaluations (each point at most once).
+    fn run(
+        shape: (usize, usize),
+        seed: (usize, usize),
+        f: &dyn Fn(usize, usize) -> f64,
+    ) -> (Refinement, Vec<f64>, usize) {
+        let mut seen = std::collections::BTreeSet::new();
+        let mut count = 0;
+        let r = refine(shape, seed, [0.1, 0.9], &mut |pts| {
+            count += pts.len();
+            for p in pts {
+                assert!(seen.insert(*p), "{p:?} evaluated twice");
+            }
+            pts.iter().map(|&(i, j)| f(i, j)).collect()
+        });
+        let full: Vec<f64> = (0..shape.0)
+            .flat_map(|i| (0..shape.1).map(move |j| (i, j)))
+            .map(|(i, j)| f(i, j))
+            .collect();
+        assert_eq!(count, r.values.len());
+        (r, full, count)
+    }
+
+    #[test]
+    fn seed_points_spread_over_the_axis() {
+        assert_eq!(spread(64, 9), vec![0, 8, 16, 24, 32, 39, 47, 55, 63]);
+        assert_eq!(spread(5, 5), vec![0, 1, 2, 3, 4]);
+        assert_eq!(spread(3, 2), vec![0, 2]);
+    }
+
+    #[test]
+    fn uniform_maps_stop_at_the_seed_grid() {
+        let (r, _, n) = run((64, 64), (9, 9), &|_, _| 0.0);
+        assert_eq!(n, 81);
+        assert_eq!(r.rounds, 0);
+        assert!(r.inferred().iter().all(|v| *v == 0.0));
+    }
+
+    /// The synthetic benchmark: on a 64 x 64 map with a known boundary, the adaptive search
+    /// must find the full grid's boundary to within one fine cell in every column, with at
+    /// most 25 % of the full grid's 4096 evaluations (the target). The counts are
+    /// printed (`cargo test -p whirlmap-sweep adaptive -- --nocapture`).
+    fn check_against_full(name: &str, f: &dyn Fn(usize, usize) -> f64) -> usize {
+        let shape = (64, 64);
+        let (r, full, count) = run(shape, (9, 9), f);
+        let a = agreement(&r.inferred(), &full, shape, 0.5, [0.1, 0.9]);
+        println!(
+            "{name}: {count} of 4096 evaluations ({:.1} %), {} rounds, {a:?}",
+            100.0 * count as f64 / 4096.0,
+            r.rounds
+        );
+        assert!(
+            boundary(&full, shape, 0.5).iter().all(Option::is_some),
+            "{name}: a boundary in every column"
+        );
+        assert!(a.max_shift_cells <= 1.0, "{name}: {a:?}");
+        assert_eq!(a.columns_differing, 0, "{name}: {a:?}");
+        assert!(count * 4 <= 4096, "{name}: {count} evaluations");
+        count
+    }
+
+    #[test]
+    fn finds_a_straight_boundary_with_a_quarter_of_the_drops() {
+        // Critical speed index falling linearly with mu, as Fig. 4's trend.
+        let n = check_against_full("line", &|i, j| {
+            f64::from(u8::from(i as f64 >= 50.0 - 0.5 * j as f64))
+        });
+        assert!(n > 81, "the boundary was refined");
+    }
+
+    #[test]
+    fn finds_a_curved_boundary_with_a_quarter_of_the_drops() {
+        // A hyperbola-like critical speed, steep at low mu and flat at high mu.
+        check_against_full("curve", &|i, j| {
+            f64::from(u8::from(i as f64 >= 4.0 + 1700.0 / (j as f64 + 30.0)))
+        });
+    }
+
+    #[test]
+    fn probability_maps_refine_the_uncertain_band_too() {
+        // A logistic P(whirl) with a band about 8 cells wide between 10 % and 90 %: its
+        // 50 % line is found to within a cell. The band is evaluated point by point, so the
+        // count is larger than for a sharp boundary; it is printed, not bounded here.
+        let shape = (64, 64);
+        let p = |i: usize, j: usize| {
+            let c = 45.0 - 0.3 * j as f64;
+            1.0 / (1.0 + (-(i as f64 - c) / 2.0).exp())
+        };
+        let (r, full, count) = run(shape, (9, 9), &p);
+        let a = agreement(&r.inferred(), &full, shape, 0.5, [0.1, 0.9]);
+        println!("logistic: {count} of 4096 evaluations, {a:?}");
+        assert!(
+            a.max_shift_cells <= 1.0 && a.columns_differing == 0,
+            "{a:?}"
+        );
+        // Every uncertain point of the full map was evaluated.
+        for (k, v) in full.iter().enumerate() {
+            if bin(*v, [0.1, 0.9]) == 1 {
+                assert!(
+                    r.values.contains_key(&(k / 64, k % 64)),
+                    "uncertain point {k} skipped"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,217 @@
+//! Fig. 4 with probability bands, from an ensemble's `contours.json`: for each friction
+//! coefficient, the speeds where P(whirl) reaches each level (10, 50, 90 % by default) as
+//! lines with their intervals as error bars, the band between the lowest and the highest
+//! level shaded, and every cell's P(whirl) as a dot shaded from white (0) to red (1).
+//! Groups are placed by their `mu` input; with further (non-speed) axes, all groups are
+//! drawn over each other.
+
+use crate::charts::{ChartError, CHART_SIZE};
+use crate::ensemble::{ContoursFile, CONTOURS_FILE};
+use crate::render::{
+    chart_header, chart_mesh, chart_text_style, render, DrawResult, Figure, TITLE_BAND, TITLE_FONT,
+    X_LABEL_AREA, Y_LABEL_AREA,
+};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+const LEVEL_COLOURS: [RGBColor; 4] = [
+    RGBColor(230, 145, 30),
+    RGBColor(200, 30, 30),
+    RGBColor(110, 20, 60),
+    RGBColor(60, 60, 160),
+];
+const BAND: RGBColor = RGBColor(214, 39, 40);
+
+struct ProbabilityFigure<'a> {
+    contours: &'a ContoursFile,
+    title: String,
+}
+
+fn mu_of(inputs: &std::collections::BTreeMap<String, f64>) -> Option<f64> {
+    inputs
+        .get("mu")
+        .or_else(|| inputs.get("mu_dynamic"))
+        .copied()
+}
+
+impl Figure for ProbabilityFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let mut groups: Vec<(f64, &crate::ensemble::ContourGroup)> = self
+            .contours
+            .groups
+            .iter()
+            .filter_map(|g| mu_of(&g.inputs).filter(|m| m.is_finite()).map(|m| (m, g)))
+            .collect();
+        groups.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let speeds: Vec<f64> = groups
+            .iter()
+            .flat_map(|(_, g)| g.speeds_rpm.iter().copied())
+            .filter(|s| s.is_finite())
+            .collect();
+        let span = |v: &[f64]| {
+            let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            if !lo.is_finite() {
+                (0.0, 1.0)
+            } else if hi > lo {
+                (lo, hi)
+            } else {
+                (lo - 1.0, lo + 1.0)
+            }
+        };
+        let (s_lo, s_hi) = span(&speeds);
+        let mus: Vec<f64> = groups.iter().map(|g| g.0).collect();
+        let (m_lo, m_hi) = span(&mus);
+        let (pad_m, pad_s) = (0.08 * (m_hi - m_lo), 0.05 * (s_hi - s_lo));
+
+        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
+        let (_, bh) = body.dim_in_pixel();
+        let (plot_area, legend_band) = body.split_vertically(bh.saturating_sub(50));
+        let mut chart = ChartBuilder::on(&plot_area)
+            .margin_top(12)
+            .margin_left(14)
+            .margin_right(34)
+            .margin_bottom(4)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
+            .build_cartesian_2d(
+                (m_lo - pad_m)..(m_hi + pad_m),
+                (s_lo - pad_s)..(s_hi + pad_s),
+            )?;
+        chart_mesh(
+            &mut chart,
+            "friction coefficient µ (-)",
+            "release speed (r/min)",
+            10,
+            8,
+        )?;
+
+        // Cells: P(whirl) as a dot from white to red.
+        for (mu, g) in &groups {
+            for (s, p) in g.speeds_rpm.iter().zip(&g.p_whirl) {
+                let Some(p) = p.filter(|p| p.is_finite() && s.is_finite()) else {
+                    continue;
+                };
+                let fill = BAND.mix(0.08 + 0.85 * p.clamp(0.0, 1.0));
+                chart.draw_series([
+                    Circle::new((*mu, *s), 5, fill.filled()),
+                    Circle::new((*mu, *s), 5, RGBColor(150, 150, 150).stroke_width(1)),
+                ])?;
+            }
+        }
+
+        let n_levels = self.contours.groups.first().map_or(0, |g| g.levels.len());
+        // The band between the lowest and the highest level; where the highest is not
+        // reached in the range, the band runs to the top of the chart.
+        if n_levels >= 2 {
+            let pts: Vec<(f64, f64, f64)> = groups
+                .iter()
+                .filter_map(|(m, g)| {
+                    let a = g.levels.first()?.speed_rpm?;
+                    let b = g.levels.last()?.speed_rpm.unwrap_or(s_hi + pad_s);
+                    Some((*m, a, b))
+                })
+                .collect();
+            if pts.len() >= 2 {
+                let poly: Vec<(f64, f64)> = pts
+                    .iter()
+                    .map(|p| (p.0, p.1))
+                    .chain(pts.iter().rev().map(|p| (p.0, p.2)))
+                    .collect();
+                chart.draw_series([Polygon::new(poly, BAND.mix(0.12).filled())])?;
+            }
+        }
+        // Each level: a line through the crossings and error bars for the intervals.
+        for k in 0..n_levels {
+            let colour = LEVEL_COLOURS[k % LEVEL_COLOURS.len()];
+            let pts: Vec<(f64, f64)> = groups
+                .iter()
+                .filter_map(|(m, g)| Some((*m, g.levels.get(k)?.speed_rpm?)))
+                .collect();
+            chart.draw_series([PathElement::new(pts.clone(), colour.stroke_width(2))])?;
+            for (m, g) in &groups {
+                let Some(l) = g.levels.get(k) else { continue };
+                if l.speed_rpm.is_none() && l.speed_lo_rpm.is_none() && l.speed_hi_rpm.is_none() {
+                    continue;
+                }
+                let lo = l.speed_lo_rpm.unwrap_or(s_lo - pad_s);
+                let hi = l.speed_hi_rpm.unwrap_or(s_hi + pad_s);
+                let dx = 0.004 * (m_hi - m_lo + 2.0 * pad_m) * (k as f64 - 1.0);
+                chart.draw_series([PathElement::new(
+                    vec![(m + dx, lo), (m + dx, hi)],
+                    colour.mix(0.7).stroke_width(2),
+                )])?;
+            }
+            chart.draw_series(
+                pts.iter()
+                    .map(|p| Circle::new(*p, 4, colour.filled()))
+                    .collect::<Vec<_>>(),
+            )?;
+        }
+
+        // Legend: one entry per level.
+        let style = chart_text_style(14.0);
+        let mut x = 60;
+        for (k, l) in self
+            .contours
+            .groups
+            .first()
+            .map(|g| g.levels.as_slice())
+            .unwrap_or_default()
+            .iter()
+            .enumerate()
+        {
+            let colour = LEVEL_COLOURS[k % LEVEL_COLOURS.len()];
+            legend_band.draw(&PathElement::new(
+                vec![(x, 20), (x + 30, 20)],
+                colour.stroke_width(3),
+            ))?;
+            let text = format!("P(whirl) = {:.0} %", 100.0 * l.level);
+            legend_band.draw_text(&text, &style, (x + 38, 11))?;
+            x += 175;
+        }
+        let text = format!(
+            "bars: {:.0} % intervals; dots: P per cell ({} drops)",
+            100.0 * self.contours.confidence,
+            self.contours.members
+        );
+        legend_band.draw_text(&text, &style, (x, 11))?;
+        Ok(())
+    }
+}
+
+/// Draws `charts/fig4_probability.{png,svg}` in `dir` if `dir/contours.json` exists;
+/// returns the files written (none without contours).
+pub fn render_probability(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
+    let path = dir.join(CONTOURS_FILE);
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(cause) => return Err(ChartError::Read { path, cause }),
+    };
+    let contours: ContoursFile = serde_json::from_str(&text).map_err(|e| ChartError::Parse {
+        path: path.clone(),
+        line: e.line(),
+        message: e.to_string(),
+    })?;
+    let out = dir.join("charts");
+    std::fs::create_dir_all(&out).map_err(|cause| ChartError::Write {
+        path: out.clone(),
+        cause,
+    })?;
+    let figure = ProbabilityFigure {
+        contours: &contours,
+        title: format!(
+            "Fig. 4 as probability: critical whirl speed bands ({})",
+            contours.name
+        ),
+    };
+    let mut written = Vec::new();
+    for ext in ["png", "svg"] {
+        let p = out.join(format!("fig4_probability.{ext}"));
+        render(&p, CHART_SIZE, &figure)?;
+        written.push(p);
+    }
+    Ok(written)
+}

@@ -1,0 +1,158 @@
+//! `whirlmap ensemble FILE` (whirl probability per cell, probability contours, Fig. 4 with
+//! bands) and `whirlmap adaptive FILE` (adaptive refinement of the whirl boundary).
+//!
+//! Exit codes: 0 ok; 1 some drop failed (outputs still written); 2 bad file or unwritable
+//! output folder (nothing run); 4 an output could not be written.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use whirlmap_sweep::adaptive::run_adaptive;
+use whirlmap_sweep::ensemble::{self, run_ensemble};
+use whirlmap_sweep::sweep::SweepError;
+
+/// Arguments of `whirlmap ensemble` and `whirlmap adaptive`.
+#[derive(clap::Args)]
+pub struct EnsembleArgs {
+    /// Ensemble file (JSON): a sweep file (name, scene, duration_s, axes) with an `ensemble`
+    /// section (and, for `adaptive`, an `adaptive` section).
+    file: PathBuf,
+    /// Output folder; default `results/<name>`.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    threads: Option<u32>,
+    /// No progress lines.
+    #[arg(long)]
+    no_progress: bool,
+    /// (adaptive only) Also run the full fine grid and report how the boundaries agree.
+    #[arg(long)]
+    compare_full: bool,
+}
+
+fn code(e: &SweepError) -> ExitCode {
+    ExitCode::from(match e {
+        SweepError::Spec(_) | SweepError::ThreadPool(_) => 2,
+        SweepError::Io { .. } => 4,
+    })
+}
+
+fn load(a: &EnsembleArgs) -> Result<(ensemble::EnsembleSpec, PathBuf), ExitCode> {
+    match ensemble::load(&a.file) {
+        Ok(s) => {
+            let out = a
+                .out
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("results").join(&s.name));
+            Ok((s, out))
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            Err(ExitCode::from(2))
+        }
+    }
+}
+
+fn fmt_speed(v: Option<f64>) -> String {
+    v.map_or("-".to_string(), |s| format!("{s:.0}"))
+}
+
+/// Runs `whirlmap ensemble`.
+pub fn run_ensemble_cmd(a: &EnsembleArgs) -> ExitCode {
+    let (spec, out) = match load(a) {
+        Ok(x) => x,
+        Err(c) => return c,
+    };
+    let o = match run_ensemble(&spec, &out, a.threads.map(|n| n as usize), !a.no_progress) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return code(&e);
+        }
+    };
+    println!(
+        "ensemble {}: {} cells x {} members = {} drops, {} failed",
+        spec.name, o.cells, o.contours.members, o.drops, o.failed
+    );
+    for g in &o.contours.groups {
+        let label = serde_json::to_string(&g.inputs).unwrap_or_default();
+        let levels: Vec<String> = g
+            .levels
+            .iter()
+            .map(|l| {
+                format!(
+                    "P{:.0}% {} [{}, {}]",
+                    100.0 * l.level,
+                    fmt_speed(l.speed_rpm),
+                    fmt_speed(l.speed_lo_rpm),
+                    fmt_speed(l.speed_hi_rpm)
+                )
+            })
+            .collect();
+        let flag = if g.non_monotone {
+            " (non-monotone)"
+        } else {
+            ""
+        };
+        println!("  {label}: {} r/min{flag}", levels.join(", "));
+    }
+    match whirlmap_sweep::prob_chart::render_probability(&out) {
+        Ok(w) => println!("  output           {} ({} charts)", out.display(), w.len()),
+        Err(e) => {
+            eprintln!("error: charts: {e}");
+            return ExitCode::from(4);
+        }
+    }
+    if o.failed > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// Runs `whirlmap adaptive`.
+pub fn run_adaptive_cmd(a: &EnsembleArgs) -> ExitCode {
+    let (spec, out) = match load(a) {
+        Ok(x) => x,
+        Err(c) => return c,
+    };
+    let (r, path) = match run_adaptive(
+        &spec,
+        &out,
+        a.threads.map(|n| n as usize),
+        a.compare_full,
+        !a.no_progress,
+    ) {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return code(&e);
+        }
+    };
+    println!(
+        "adaptive {}: {} of {} drops ({:.1} %) for a {} x {} grid from a {} x {} seed, {} rounds, {} boundary cells",
+        r.name,
+        r.drops_used,
+        r.full_grid_drops,
+        100.0 * r.drops_ratio,
+        r.fine_points.0,
+        r.fine_points.1,
+        r.seed_points.0,
+        r.seed_points.1,
+        r.rounds,
+        r.boundary_cells
+    );
+    if let Some(c) = &r.comparison {
+        let g = &c.agreement;
+        println!(
+            "  against the full grid: boundary within {} fine speed steps, {} columns differ, {} points differ",
+            g.max_shift_cells, g.columns_differing, g.points_differing
+        );
+    }
+    println!("  output           {}", path.display());
+    if r.evaluated.iter().any(|c| c.p_whirl.is_nan()) {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}

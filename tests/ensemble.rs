@@ -1,0 +1,223 @@
+//! End-to-end tests of `whirlmap ensemble` and `whirlmap adaptive`: reproducibility (same
+//! seed, same bytes; 1 and 2 threads byte-identical), a changed seed changes the draws,
+//! bad files exit 2 naming the field, the statistics are consistent with the members, and
+//! the adaptive search on a small real grid uses fewer drops and matches the full grid.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_whirlmap");
+
+fn whirlmap(args: &[&str]) -> Output {
+    Command::new(BIN)
+        .args(args)
+        .output()
+        .expect("runs the binary")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("whirlmap-ens-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn smoke() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/ensemble-smoke.json")
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+const OUTPUTS: [&str; 4] = ["members.jsonl", "cells.jsonl", "cells.csv", "contours.json"];
+
+#[test]
+fn same_seed_same_bytes_for_one_and_two_threads() {
+    let dir = temp_dir("repro");
+    let (a, b, c) = (dir.join("a"), dir.join("b"), dir.join("c"));
+    for (out, threads) in [(&a, "1"), (&b, "2"), (&c, "2")] {
+        let o = whirlmap(&[
+            "ensemble",
+            s(&smoke()),
+            "--out",
+            s(out),
+            "--threads",
+            threads,
+            "--no-progress",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    for f in OUTPUTS {
+        let x = read(&a.join(f));
+        assert!(!x.is_empty(), "{f}");
+        assert_eq!(x, read(&b.join(f)), "{f}: 1 vs 2 threads");
+        assert_eq!(x, read(&c.join(f)), "{f}: a second run");
+    }
+    assert!(a.join("charts/fig4_probability.png").exists());
+    assert!(a.join("charts/fig4_probability.svg").exists());
+
+    // The statistics agree with the members: P = whirl / ok, p_lo <= P <= p_hi, and the
+    // draws respect the declared bounds.
+    let members: Vec<serde_json::Value> = read(&a.join("members.jsonl"))
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(members.len(), 16);
+    for m in &members {
+        let d = &m["drawn"];
+        let e = d["unbalance_m"].as_f64().unwrap();
+        assert!((0.0..5e-6).contains(&e), "{d}");
+        let r = d["release_offset_m"][0]
+            .as_f64()
+            .unwrap()
+            .hypot(d["release_offset_m"][1].as_f64().unwrap());
+        assert!(r <= 2e-5 + 1e-18, "{d}");
+        let w = d["race_speed_rad_s"].as_f64().unwrap();
+        assert!((0.0..10.0).contains(&w), "{d}");
+    }
+    for line in read(&a.join("cells.jsonl")).lines() {
+        let c: serde_json::Value = serde_json::from_str(line).unwrap();
+        let idx = c["index"].as_u64().unwrap();
+        let whirl = members
+            .iter()
+            .filter(|m| m["cell"].as_u64() == Some(idx))
+            .filter(|m| {
+                matches!(
+                    m["class"].as_str(),
+                    Some("backward_whirl") | Some("forward_whirl")
+                )
+            })
+            .count();
+        assert_eq!(c["whirl"].as_u64().unwrap() as usize, whirl);
+        let p = c["p_whirl"].as_f64().unwrap();
+        assert_eq!(p, whirl as f64 / c["ok"].as_f64().unwrap());
+        assert!(c["p_lo"].as_f64().unwrap() <= p && p <= c["p_hi"].as_f64().unwrap());
+        let f = &c["max_contact_force_n"];
+        assert!(f["p10"].as_f64() <= f["p50"].as_f64() && f["p50"].as_f64() <= f["p90"].as_f64());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn another_seed_draws_other_members() {
+    let dir = temp_dir("seed");
+    let text = read(&smoke()).replace("\"seed\": 1", "\"seed\": 2");
+    assert!(text.contains("\"seed\": 2"));
+    let file = dir.join("seed2.json");
+    std::fs::write(&file, text).unwrap();
+    for (f, out) in [(smoke(), dir.join("a")), (file, dir.join("b"))] {
+        let o = whirlmap(&["ensemble", s(&f), "--out", s(&out), "--no-progress"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let a = read(&dir.join("a/members.jsonl"));
+    let b = read(&dir.join("b/members.jsonl"));
+    let first =
+        |t: &str| -> serde_json::Value { serde_json::from_str(t.lines().next().unwrap()).unwrap() };
+    assert_ne!(first(&a)["drawn"], first(&b)["drawn"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_ensemble_files_exit_2_and_name_the_field() {
+    let dir = temp_dir("bad");
+    let base = r#""name": "bad", "duration_s": 0.05, "axes": {"speed_rpm": [4000], "mu": [0.3]}"#;
+    let cases: &[(&str, &[&str])] = &[
+        (
+            r#""ensemble": {"members": 0, "seed": 1}"#,
+            &["ensemble.members"],
+        ),
+        (
+            r#""ensemble": {"members": 2, "seed": 1, "unbalance_m": {"uniform": {"from": 2e-6, "to": 1e-6}}}"#,
+            &["ensemble.unbalance_m"],
+        ),
+        (
+            r#""ensemble": {"members": 2, "seed": 1, "orbit_radius_m": {"fixed": 1.4e-4}}"#,
+            &["release_offset_m", "widest"],
+        ),
+        (
+            r#""ensemble": {"members": 2, "seed": 1, "race_speed": {"fixed": 1}}"#,
+            &["race_speed", "line"],
+        ),
+        (
+            r#""ensemble": {"members": 2, "seed": 1, "levels": [1.5]}"#,
+            &["ensemble.levels"],
+        ),
+        (
+            r#""adaptive": {"seed_speed_points": 2, "seed_mu_points": 2}"#,
+            &["adaptive.seed_speed_points", "at least 2 points"],
+        ),
+    ];
+    for (i, (section, words)) in cases.iter().enumerate() {
+        let f = dir.join(format!("bad{i}.json"));
+        std::fs::write(&f, format!("{{{base}, {section}}}")).unwrap();
+        let out = dir.join(format!("out{i}"));
+        let o = whirlmap(&["ensemble", s(&f), "--out", s(&out)]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{section}: {err}");
+        for w in *words {
+            assert!(err.contains(w), "{section}: `{w}` not in {err}");
+        }
+        assert!(!out.join("members.jsonl").exists(), "nothing runs");
+    }
+    // No ensemble section: `ensemble` refuses.
+    let f = dir.join("none.json");
+    std::fs::write(&f, format!("{{{base}}}")).unwrap();
+    let o = whirlmap(&["ensemble", s(&f), "--out", s(&dir.join("none"))]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("ensemble"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A small real adaptive search (single 0.1 s drops, 9 x 5 fine grid, 3 x 3 seed): the
+/// report's counts are consistent and the boundary agrees with the full grid's to within a
+/// fine cell. Too small for the 25 % target (the seed grid alone is 20 % of it; measured 33
+/// of 45): that is
+/// the synthetic benchmark's job (`crates/sweep/src/adaptive.rs`).
+#[test]
+fn adaptive_search_on_a_small_real_grid_matches_the_full_grid() {
+    let dir = temp_dir("adaptive");
+    let f = dir.join("a.json");
+    std::fs::write(
+        &f,
+        r#"{"name": "a", "duration_s": 0.1,
+            "axes": {"speed_rpm": {"from": 2000, "to": 18000, "steps": 9},
+                     "mu": {"from": 0.3, "to": 0.5, "steps": 5}},
+            "adaptive": {"seed_speed_points": 3, "seed_mu_points": 3}}"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = whirlmap(&[
+        "adaptive",
+        s(&f),
+        "--out",
+        s(&out),
+        "--compare-full",
+        "--no-progress",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_str(&read(&out.join("adaptive.json"))).unwrap();
+    println!("{}", String::from_utf8_lossy(&o.stdout));
+    assert_eq!(r["full_grid_drops"], 45);
+    let used = r["drops_used"].as_u64().unwrap();
+    assert_eq!(used as usize, r["evaluated"].as_array().unwrap().len());
+    assert!((9..=45).contains(&used), "{used}");
+    let crossings = r["boundary"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|b| b["speed_rpm"].is_number())
+        .count();
+    assert!(
+        crossings >= 2,
+        "the grid holds a whirl boundary: {}",
+        r["boundary"]
+    );
+    let a = &r["comparison"]["agreement"];
+    assert!(a["max_shift_cells"].as_f64().unwrap() <= 1.0, "{a}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
