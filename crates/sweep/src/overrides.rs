@@ -98,7 +98,7 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
         let Some(next) = obj.get_mut(*part) else {
             return Err(OverrideError::UnknownKey {
                 key: key.to_string(),
-                known: format!("(`{part}` is not set in this scene; set it whole first)"),
+                known: format!("none (`{part}` is not set in this scene: set it whole first, e.g. `--set {part}={{}}`, or use --thermal)"),
             });
         };
         node = next;
