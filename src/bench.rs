@@ -4,7 +4,7 @@ use std::hint::black_box;
 use std::time::Instant;
 use whirlmap_core::model::{ix, DropSystem, Mode, Slip};
 use whirlmap_core::ode::OdeSystem;
-use whirlmap_core::{simulate, DropOptions, Scene, StopReason};
+use whirlmap_core::{simulate, DropOptions, DropReport, Fidelity, Scene, StopReason};
 
 /// Options of `whirlmap bench`.
 #[derive(clap::Args)]
@@ -12,13 +12,16 @@ pub struct BenchArgs {
     /// Repetitions per drop case (the median wall time is reported).
     #[arg(long, default_value_t = 5)]
     reps: usize,
-    /// Also run the 60 s thermal coast-down of `scenes/coast-down.json` once (about 15 s).
+    /// Also run the long thermal scenes (`scenes/coast-down.json` to its stop speed and for
+    /// 60 s, `scenes/runaway.json` for 60 s), each with the full model and with the `draft`
+    /// fidelity (quasi-static race), and compare them (about 30 s of CPU in all).
     #[arg(long)]
     coast_down: bool,
 }
 
-/// The coast-down scene, embedded so the bench needs no files.
+/// The long thermal scenes, embedded so the bench needs no files.
 const COAST_DOWN_SCENE: &str = include_str!("../scenes/coast-down.json");
+const RUNAWAY_SCENE: &str = include_str!("../scenes/runaway.json");
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -36,41 +39,22 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         "{:<34} {:>10} {:>11} {:>9} {:>8} {:>7} {:>12}",
         "case", "wall ms", "RHS evals", "steps", "rejected", "events", "ns/RHS eval"
     );
-    let coast: Scene = serde_json::from_str(COAST_DOWN_SCENE)?;
     let cases = [
-        ("pendulum 8000 r/min mu 0.1, 1 s", 8000.0, 0.1, false, 1.0),
-        ("same, thermal model on", 8000.0, 0.1, true, 1.0),
-        ("whirl 8000 r/min mu 0.4 (rule)", 8000.0, 0.4, false, 1.0),
-        (
-            "thermal coast-down (<= 60 s)",
-            f64::NAN,
-            f64::NAN,
-            true,
-            60.0,
-        ),
+        ("pendulum 8000 r/min mu 0.1, 1 s", 8000.0, 0.1, false),
+        ("same, thermal model on", 8000.0, 0.1, true),
+        ("whirl 8000 r/min mu 0.4 (rule)", 8000.0, 0.4, false),
     ];
-    for (name, speed, mu, thermal, duration_s) in cases {
-        let coast_down = speed.is_nan();
-        if coast_down && !a.coast_down {
-            continue;
-        }
-        let mut scene = if coast_down {
-            coast.clone()
-        } else {
-            Scene::paper()
-        };
-        if !coast_down {
-            scene.speed_rpm = speed;
-            scene.mu_dynamic = mu;
-            if thermal {
-                scene.thermal = Some(whirlmap_core::ThermalParams::default());
-            }
+    for (name, speed, mu, thermal) in cases {
+        let mut scene = Scene::paper();
+        scene.speed_rpm = speed;
+        scene.mu_dynamic = mu;
+        if thermal {
+            scene.thermal = Some(whirlmap_core::ThermalParams::default());
         }
         let opts = DropOptions {
-            duration_s,
+            duration_s: 1.0,
             ..Default::default()
         };
-        let reps = if coast_down { 1 } else { reps };
         let mut walls = Vec::new();
         let mut last = None;
         for _ in 0..reps {
@@ -80,30 +64,16 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             last = Some(r);
         }
         let r = last.expect("reps >= 1");
-        let wall = median(walls);
-        let note = if r.stop_reason == StopReason::WhirlTurnsReached {
-            " (whirl decided)"
-        } else {
-            ""
-        };
-        println!(
-            "{:<34} {:>10.2} {:>11} {:>9} {:>8} {:>7} {:>12.0}{note}",
-            name,
-            wall,
-            r.stats.rhs_evals,
-            r.stats.steps,
-            r.stats.rejected,
-            r.stats.events,
-            wall * 1e6 / r.stats.rhs_evals as f64
-        );
+        print_row(name, median(walls), &r);
         if let Some(th) = &r.thermal {
             println!(
-                "    {:.3} s simulated: {:.0} dynamic RHS evaluations and {:.0} network steps per simulated second",
-                r.end_time_s,
-                r.stats.rhs_evals as f64 / r.end_time_s,
-                th.network_steps as f64 / r.end_time_s
+                "    {} network steps for {:.3} s simulated",
+                th.network_steps, r.end_time_s
             );
         }
+    }
+    if a.coast_down {
+        thermal_pairs()?;
     }
     // One right-hand-side evaluation at a loaded, slipping contact (drag on).
     let scene = Scene::paper();
@@ -132,6 +102,132 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         }
         let ns = t.elapsed().as_secs_f64() * 1e9 / n as f64;
         println!("one RHS evaluation (contact, {label}, drag on): {ns:.1} ns");
+    }
+    Ok(())
+}
+
+/// One row of the bench table.
+fn print_row(name: &str, wall_ms: f64, r: &DropReport) {
+    let note = if r.stop_reason == StopReason::WhirlTurnsReached {
+        " (whirl decided)"
+    } else {
+        ""
+    };
+    println!(
+        "{:<34} {:>10.2} {:>11} {:>9} {:>8} {:>7} {:>12.0}{note}",
+        name,
+        wall_ms,
+        r.stats.rhs_evals,
+        r.stats.steps,
+        r.stats.rejected,
+        r.stats.events,
+        wall_ms * 1e6 / r.stats.rhs_evals as f64
+    );
+}
+
+/// CPU time of the calling thread (s), from `/proc/thread-self/schedstat` (Linux; its first
+/// field is the time on CPU in ns). On a shared machine the wall time counts the other jobs'
+/// share too; this does not. Read by hand rather than through a crate: one file, one number.
+fn thread_cpu_s() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
+}
+
+/// Runs one long thermal drop (to `duration_s` or the scene's stop speed) and prints its
+/// table row, its work per simulated second and its CPU time.
+fn long_thermal_run(name: &str, scene: &Scene, duration_s: f64) -> anyhow::Result<DropReport> {
+    let opts = DropOptions {
+        duration_s,
+        ..Default::default()
+    };
+    let (t, c) = (Instant::now(), thread_cpu_s());
+    let r = simulate(scene, &opts)?;
+    let wall = t.elapsed().as_secs_f64();
+    let cpu = c.zip(thread_cpu_s()).map(|(a, b)| b - a);
+    print_row(name, wall * 1e3, &r);
+    let th = r.thermal.as_ref().expect("a thermal scene");
+    let per_60 = |x: f64| x * 60.0 / r.end_time_s;
+    println!(
+        "    {:.2} s simulated ({:?}): {:.0} dynamic RHS evaluations and {:.0} network steps per simulated second; \
+         CPU {} ({} per 60 s simulated)",
+        r.end_time_s,
+        r.stop_reason,
+        r.stats.rhs_evals as f64 / r.end_time_s,
+        th.network_steps as f64 / r.end_time_s,
+        cpu.map_or("n/a".into(), |c| format!("{c:.2} s")),
+        cpu.map_or("n/a".into(), |c| format!("{:.2} s", per_60(c))),
+    );
+    Ok(r)
+}
+
+/// What the quasi-static race changes in what a thermal run is for: temperatures, thermal
+/// load, heat energies, end speed and time.
+fn print_thermal_differences(full: &DropReport, draft: &DropReport) {
+    let (a, b) = (
+        full.thermal.as_ref().expect("thermal"),
+        draft.thermal.as_ref().expect("thermal"),
+    );
+    let (ta, tb) = (a.temperatures_k.as_array(), b.temperatures_k.as_array());
+    // The first sample is the release, every node at ambient.
+    let rise = a.temperatures_k.hottest_peak_k() - a.series[0].temperatures_k[0];
+    let d_t = ta
+        .iter()
+        .zip(&tb)
+        .map(|(x, y)| {
+            (x.final_k - y.final_k)
+                .abs()
+                .max((x.peak_k - y.peak_k).abs())
+        })
+        .fold(0.0, f64::max);
+    let (ha, hb) = (a.heat, b.heat);
+    println!(
+        "    draft vs full: largest node temperature difference (final or peak) {:.4} K = {:.1e} of the {:.2} K rise; \
+         peak F_th {:.3} vs {:.3} N",
+        d_t,
+        d_t / rise,
+        rise,
+        b.peak_thermal_load_n,
+        a.peak_thermal_load_n
+    );
+    println!(
+        "    heat H_s {:.3} vs {:.3} J, H_i {:.3} vs {:.3} J, H_o {:.3} vs {:.3} J; end {:.3} vs {:.3} s, \
+         rotor {:.1} vs {:.1} r/min, race {:.1} vs {:.1} r/min",
+        hb.h_s_j,
+        ha.h_s_j,
+        hb.h_i_j,
+        ha.h_i_j,
+        hb.h_o_j,
+        ha.h_o_j,
+        draft.end_time_s,
+        full.end_time_s,
+        draft.features.final_rotor_speed_rpm,
+        full.features.final_rotor_speed_rpm,
+        draft.features.final_race_speed_rpm,
+        full.features.final_race_speed_rpm,
+    );
+}
+
+/// The long thermal scenes with the full model and with the draft fidelity (quasi-static
+/// race at rtol 1e-4), side by side.
+fn thermal_pairs() -> anyhow::Result<()> {
+    let coast: Scene = serde_json::from_str(COAST_DOWN_SCENE)?;
+    let mut coast_60 = coast.clone();
+    coast_60.stop_speed_rpm = None;
+    let runaway: Scene = serde_json::from_str(RUNAWAY_SCENE)?;
+    let scenes = [
+        ("coast-down to 1000 r/min", coast),
+        ("coast-down, 60 s", coast_60),
+        ("runaway, 60 s", runaway),
+    ];
+    for (name, scene) in scenes {
+        let full = long_thermal_run(&format!("{name} (full)"), &scene, 60.0)?;
+        let draft = long_thermal_run(
+            &format!("{name} (draft)"),
+            &Fidelity::Draft.applied(&scene),
+            60.0,
+        )?;
+        print_thermal_differences(&full, &draft);
     }
     Ok(())
 }
