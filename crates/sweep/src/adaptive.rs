@@ -3,20 +3,25 @@
 //!
 //! ## Algorithm ([`refine`], generic over the evaluation)
 //! The fine grid (the `speed_rpm` and `mu` axes of the file) fixes the smallest cell. Seed
-//! points are spread evenly over its indices. A cell is refined when its corners disagree:
-//! each corner's value (P(whirl), or 0/1 for single drops) falls in a bin, "safe" (<= the
-//! lower bound), "whirl" (>= the upper bound) or "uncertain" (between); a cell is split
-//! unless all four corners share the safe or the whirl bin. Splitting is at the integer
-//! midpoints of its index ranges (only along ranges wider than one fine step), so every
-//! corner is a fine-grid point. Rounds continue until no cell can split; a refined 1 x 1
-//! cell is a boundary cell. Every round's new corners are evaluated as one batch in index
-//! order and cached, so no corner is evaluated twice and the order (and the result) is
-//! deterministic. Failed evaluations (NaN) count as uncertain.
+//! points are spread evenly over its indices. Each evaluated point's value (P(whirl), or 0/1
+//! for single drops) falls in a bin, "safe" (<= the lower bound), "whirl" (>= the upper
+//! bound) or "uncertain" (between). A cell is split unless every evaluated point in it
+//! (closed: its corners, and points on its edges or inside that finer neighbouring cells
+//! have evaluated) shares the safe or the whirl bin. Splitting is at the integer midpoints
+//! of its index ranges (only along ranges wider than one fine step), so every corner is a
+//! fine-grid point. Every cell is checked again each round, so a feature narrower than a
+//! cell (a tongue of non-whirl between whirl regions), once a neighbour's refinement has
+//! found a point of it on the cell's edge, splits the cell and is followed along. Rounds
+//! continue until no cell splits; a 1 x 1 cell that disagrees is a boundary cell. Every
+//! round's new corners are evaluated as one batch in index order and cached, so no corner
+//! is evaluated twice and the order (and the result) is deterministic. Failed evaluations
+//! (NaN) count as uncertain.
 //!
-//! Every fine point not evaluated lies in a leaf whose corners agree, and takes their value
-//! ([`Refinement::inferred`]). The known blind spot of corner tests: a boundary that enters
-//! and leaves a seed cell through the same edge, or an island smaller than a seed cell, is
-//! not seen. The seed grid must be fine enough for the features sought.
+//! Every fine point not evaluated lies in a leaf whose known points agree, and takes its
+//! corners' value ([`Refinement::inferred`]). The remaining blind spot: a feature that
+//! touches no refined cell (an island inside a seed cell whose corners agree, or a tongue
+//! that enters and leaves such a cell through one edge) is not seen. The seed grid must be
+//! fine enough for those.
 //!
 //! ## Use
 //! `whirlmap adaptive FILE [--compare-full]`: the file is an ensemble file
@@ -188,6 +193,47 @@ fn bin(v: f64, [lo, hi]: [f64; 2]) -> u8 {
     }
 }
 
+/// A cell disagrees unless every evaluated point in it (corners, and any point on its edges
+/// or inside that a neighbouring, finer cell has evaluated) is safe, or every one is whirl.
+/// The points beyond the corners let a feature narrower than the cell (a tongue of the
+/// other class) be followed from where a neighbour's refinement has found it.
+fn disagrees(c: &Leaf, values: &BTreeMap<(usize, usize), f64>, bounds: [f64; 2]) -> bool {
+    let first = bin(values[&(c.i0, c.j0)], bounds);
+    if first == 1 {
+        return true;
+    }
+    (c.i0..=c.i1).any(|i| {
+        values
+            .range((i, c.j0)..=(i, c.j1))
+            .any(|(_, v)| bin(*v, bounds) != first)
+    })
+}
+
+/// The halves (or quarters) of a cell, split at the integer midpoints of the index ranges
+/// wider than one fine step.
+fn split(c: &Leaf) -> Vec<Leaf> {
+    let halves = |a: usize, b: usize| {
+        if b - a > 1 {
+            vec![(a, (a + b) / 2), ((a + b) / 2, b)]
+        } else {
+            vec![(a, b)]
+        }
+    };
+    let mut out = Vec::with_capacity(4);
+    for (i0, i1) in halves(c.i0, c.i1) {
+        for (j0, j1) in halves(c.j0, c.j1) {
+            out.push(Leaf {
+                i0,
+                i1,
+                j0,
+                j1,
+                boundary: false,
+            });
+        }
+    }
+    out
+}
+
 /// Evaluates a batch of fine points (speed index, mu index), in index order, to one value
 /// each in the same order.
 pub type BatchEval<'a> = dyn FnMut(&[(usize, usize)]) -> Vec<f64> + 'a;
@@ -233,55 +279,36 @@ pub fn refine(
         })
         .collect();
     evaluate(&cells, &mut values);
-    let mut leaves = Vec::new();
+    // `cells` is the current partition. Each round splits every cell that disagrees (see
+    // `disagrees`), in place; cells kept in one round are checked again in the next, as
+    // points evaluated around them may now lie on their edges.
     let mut rounds = 0;
     loop {
-        let mut next = Vec::new();
+        let mut next = Vec::with_capacity(cells.len());
+        let mut split_any = false;
         for c in &cells {
-            let b: Vec<u8> = c.corners().iter().map(|p| bin(values[p], bounds)).collect();
-            let agree = b[0] != 1 && b.iter().all(|x| *x == b[0]);
-            if agree {
-                leaves.push(*c);
+            let splittable = c.i1 - c.i0 > 1 || c.j1 - c.j0 > 1;
+            if !splittable || !disagrees(c, &values, bounds) {
+                next.push(*c);
                 continue;
             }
-            let split_i = c.i1 - c.i0 > 1;
-            let split_j = c.j1 - c.j0 > 1;
-            if !split_i && !split_j {
-                leaves.push(Leaf {
-                    boundary: true,
-                    ..*c
-                });
-                continue;
-            }
-            let is = if split_i {
-                vec![(c.i0, (c.i0 + c.i1) / 2), ((c.i0 + c.i1) / 2, c.i1)]
-            } else {
-                vec![(c.i0, c.i1)]
-            };
-            let js = if split_j {
-                vec![(c.j0, (c.j0 + c.j1) / 2), ((c.j0 + c.j1) / 2, c.j1)]
-            } else {
-                vec![(c.j0, c.j1)]
-            };
-            for &(i0, i1) in &is {
-                for &(j0, j1) in &js {
-                    next.push(Leaf {
-                        i0,
-                        i1,
-                        j0,
-                        j1,
-                        boundary: false,
-                    });
-                }
-            }
+            split_any = true;
+            next.extend(split(c));
         }
-        if next.is_empty() {
+        if !split_any {
             break;
         }
         rounds += 1;
         evaluate(&next, &mut values);
         cells = next;
     }
+    let mut leaves: Vec<Leaf> = cells
+        .into_iter()
+        .map(|c| Leaf {
+            boundary: c.i1 - c.i0 <= 1 && c.j1 - c.j0 <= 1 && disagrees(&c, &values, bounds),
+            ..c
+        })
+        .collect();
     leaves.sort_by_key(|l| (l.i0, l.j0, l.i1, l.j1));
     Refinement {
         shape,
@@ -674,6 +701,25 @@ mod tests {
         check_against_full("curve", &|i, j| {
             f64::from(u8::from(i as f64 >= 4.0 + 1700.0 / (j as f64 + 30.0)))
         });
+    }
+
+    #[test]
+    fn follows_a_tongue_narrower_than_a_seed_cell() {
+        // The paper scene's feature: a strip of non-whirl four columns wide (j 33-36, inside
+        // the seed cell j 32-39) across every speed, between whirl regions. Its corners
+        // alone never see it above the boundary; the points found on its edge where the
+        // boundary crosses it do, and the strip is followed to the top speed.
+        let f = |i: usize, j: usize| {
+            let strip = (33..=36).contains(&j);
+            f64::from(u8::from(!strip && i as f64 >= 50.0 - 0.5 * j as f64))
+        };
+        let shape = (64, 64);
+        let (r, full, count) = run(shape, (9, 9), &f);
+        let a = agreement(&r.inferred(), &full, shape, 0.5, [0.1, 0.9]);
+        println!("tongue: {count} of 4096 evaluations, {a:?}");
+        assert_eq!(a.columns_differing, 0, "{a:?}");
+        assert_eq!(a.points_differing, 0, "{a:?}");
+        assert!(count * 4 <= 4096, "{count} evaluations");
     }
 
     #[test]
