@@ -39,15 +39,26 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         "{:<34} {:>10} {:>11} {:>9} {:>8} {:>7} {:>12}",
         "case", "wall ms", "RHS evals", "steps", "rejected", "events", "ns/RHS eval"
     );
+    // The last four rows: the linearly implicit ROS34PW2 with the free-flight gap bound
+    // (README, "Speed against accuracy"), at two tolerances.
     let cases = [
-        ("pendulum 8000 r/min mu 0.1, 1 s", 8000.0, 0.1, false),
-        ("same, thermal model on", 8000.0, 0.1, true),
-        ("whirl 8000 r/min mu 0.4 (rule)", 8000.0, 0.4, false),
+        ("pendulum 8000 r/min mu 0.1, 1 s", 8000.0, 0.1, false, None),
+        ("same, thermal model on", 8000.0, 0.1, true, None),
+        ("whirl 8000 r/min mu 0.4 (rule)", 8000.0, 0.4, false, None),
+        ("pendulum, ros34pw2+gap rtol 1e-4", 8000.0, 0.1, false, Some(1e-4)),
+        ("whirl, ros34pw2+gap rtol 1e-4", 8000.0, 0.4, false, Some(1e-4)),
+        ("pendulum, ros34pw2+gap rtol 1e-5", 8000.0, 0.1, false, Some(1e-5)),
+        ("whirl, ros34pw2+gap rtol 1e-5", 8000.0, 0.4, false, Some(1e-5)),
     ];
-    for (name, speed, mu, thermal) in cases {
+    for (name, speed, mu, thermal, implicit) in cases {
         let mut scene = Scene::paper();
         scene.speed_rpm = speed;
         scene.mu_dynamic = mu;
+        if let Some(rtol) = implicit {
+            scene.solver.method = whirlmap_core::Method::Ros34pw2;
+            scene.solver.free_flight_gap_bound = true;
+            scene.solver.rtol = rtol;
+        }
         if thermal {
             scene.thermal = Some(whirlmap_core::ThermalParams::default());
         }

@@ -5,7 +5,7 @@ use crate::error::{InvalidParameter, SolveError};
 use crate::model::{ix, DropSystem, Mode, Slip, N};
 use crate::monitor::{Features, Monitor};
 use crate::ode::{
-    integrate, Dop853, Dopri5, NoObserver, Observer, Stats, StepControl, StepView, Stepper, Stop,
+    integrate, Dop853, Dopri5, Ros34pw2, NoObserver, Observer, Stats, StepControl, StepView, Stepper, Stop,
 };
 use crate::orbit::Orbit;
 use crate::scene::{Method, Scene};
@@ -260,6 +260,7 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
     match scene.solver.method {
         Method::Dopri5 => run_with(scene, opts, extra, sys, Dopri5::new(ctl)),
         Method::Dop853 => run_with(scene, opts, extra, sys, Dop853::new(ctl)),
+        Method::Ros34pw2 => run_with(scene, opts, extra, sys, Ros34pw2::new(ctl)),
     }
 }
 

@@ -34,6 +34,10 @@ pub enum Method {
     /// Hairer's DOP853, 8(5,3) with 7th-order dense output: the independent reference of
     /// `whirlmap accuracy` (see `ode/dop853.rs` for why it is hand-written).
     Dop853,
+    /// ROS34PW2, a linearly implicit Rosenbrock-W method of order 3 (Rang and Angermann
+    /// 2005) with an analytic stiff Jacobian: its step is not bounded by the light race's
+    /// contact mode (`ode/rosw.rs`).
+    Ros34pw2,
 }
 
 impl Method {
@@ -64,11 +68,19 @@ pub struct SolverSettings {
     pub max_step_attempts: u64,
     /// Located mode switches before a typed budget error (chatter guard). Default 2 000 000.
     pub max_events: u64,
-    /// The Runge-Kutta pair. Default `dopri5`; `dop853` is the reference integrator.
+    /// The integrator. Default `dopri5`; `dop853` is the reference integrator; `ros34pw2`
+    /// is the linearly implicit Rosenbrock-W method (README, "Speed against accuracy").
     /// Omitted from the canonical JSON (and the hash) while it is the default.
     #[serde(skip_serializing_if = "Method::is_default")]
     pub method: Method,
+    /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
+    /// lower bound on the time until the contact can close (gap, relative speed, and a
+    /// bound on the relative acceleration). Default false (the fixed cap alone); the
+    /// `standard` preset turns it on. Omitted from the canonical JSON while false.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub free_flight_gap_bound: bool,
 }
+
 
 impl Default for SolverSettings {
     fn default() -> Self {
@@ -80,6 +92,7 @@ impl Default for SolverSettings {
             max_step_attempts: 20_000_000,
             max_events: 2_000_000,
             method: Method::Dopri5,
+            free_flight_gap_bound: false,
         }
     }
 }

@@ -56,6 +56,9 @@ fn show_optional_fields(root: &mut Value) {
             solver
                 .entry("method")
                 .or_insert(Value::String("dopri5".into()));
+            solver
+                .entry("free_flight_gap_bound")
+                .or_insert(Value::Bool(false));
         }
     }
 }

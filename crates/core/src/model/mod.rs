@@ -14,7 +14,7 @@ pub mod friction;
 pub mod hertz;
 pub mod quasi_static;
 
-use crate::ode::{OdeSystem, MAX_GUARDS};
+use crate::ode::{OdeSystem, StiffJacobian, MAX_GUARDS};
 use crate::scene::{FrictionLaw, Scene};
 pub use friction::Slip;
 
@@ -130,6 +130,7 @@ pub struct DropSystem {
     drag: Option<drag::Palmgren>,
     omega_eps: f64,
     free_max_step: f64,
+    free_gap_bound: bool,
     f_ref: f64,
     f_ref_b: f64,
     /// Reduced model: massless race translation (series springs), when the scene asks.
@@ -176,6 +177,7 @@ impl DropSystem {
             }),
             omega_eps: scene.drag_zero_speed_rad_s,
             free_max_step: scene.solver.free_flight_max_step_s,
+            free_gap_bound: scene.solver.free_flight_gap_bound,
             f_ref: (m_r * g).max(1e-3),
             f_ref_b: (m_b * g).max(1e-6),
             series: scene.quasi_static_race.then(|| {
@@ -481,6 +483,178 @@ impl OdeSystem<N> for DropSystem {
         } else {
             2
         }
+    }
+
+    /// The stiff part of the Jacobian for the linearly implicit stepper: the two Hertz
+    /// contacts' normal forces (eq. 7, spring and damper, with the turning of the contact
+    /// normal), the friction that follows them (eq. 8; the regularised law's slope in the
+    /// slip velocity too), over the translations, their rates and the two spins. Left out,
+    /// because they are not stiff: gravity, the unbalance terms, Palmgren drag, and the
+    /// sticking constraint's dependence on the state.
+    fn stiff_jacobian(&self, _t: f64, y: &[f64; N]) -> Option<StiffJacobian> {
+        use ix::*;
+        let mut sj = StiffJacobian::over(&[XR, YR, XB, YB, VXR, VYR, VXB, VYB, WR, WB]);
+        let j = &mut sj.jac;
+        for a in 0..4 {
+            j[a][4 + a] = 1.0;
+        }
+        let f = self.forces(y);
+        if self.mode.contact && f.dist_m > 0.0 {
+            let (n, t, dist) = (f.n, f.t, f.dist_m);
+            let w = [y[VXR] - y[VXB], y[VYR] - y[VYB]];
+            let wn = w[0] * n[0] + w[1] * n[1];
+            let pw = [w[0] - n[0] * wn, w[1] - n[1] * wn];
+            // P = I - n n^T and R P with R the quarter turn (t = R n).
+            let pm = [[1.0 - n[0] * n[0], -n[0] * n[1]], [-n[1] * n[0], 1.0 - n[1] * n[1]]];
+            let rp = [[-pm[1][0], -pm[1][1]], [pm[0][0], pm[0][1]]];
+            let (kd, c) = match &self.series {
+                Some(ss) => {
+                    // Series springs: dF/dd = F / (a/e1 + b/e2); the split damper's weight
+                    // w = (a/e1) / (a/e1 + b/e2) moves with d too (its slope times delta_dot
+                    // joins the stiffness).
+                    let sp = ss.split(f.delta_m);
+                    let (p, q) = (ss.inv_e1(), ss.inv_e2());
+                    let (a, b, fa) = (sp.delta_m, sp.support_m, sp.force_n.abs());
+                    let denom = a * p + b * q;
+                    let wc = sp.w_contact;
+                    let c = self.c1 * wc * wc + self.c2 * (1.0 - wc) * (1.0 - wc);
+                    let kd = if denom > 0.0 && fa > 0.0 {
+                        let k = fa / denom;
+                        let dw = p * q * a * b * (p - q) * k / (fa * denom * denom);
+                        let dc = 2.0 * (self.c1 * wc - self.c2 * (1.0 - wc)) * dw;
+                        k + dc * f.delta_dot_m_s
+                    } else {
+                        0.0
+                    };
+                    (kd, c)
+                }
+                None => {
+                    let d = f.delta_m.max(0.0);
+                    let kd = if d > 0.0 {
+                        self.k1 * self.e1 * hertz::signed_pow(d, self.e1) / d
+                    } else {
+                        0.0
+                    };
+                    (kd, self.c1)
+                }
+            };
+            let (fnn, ft) = (f.normal_n, f.friction_n);
+            let dfn_dd = [kd * n[0] + c * pw[0] / dist, kd * n[1] + c * pw[1] / dist];
+            let dfn_dw = [c * n[0], c * n[1]];
+            // Friction: d F_t over d, w and the two spins.
+            let (mut dft_dd, mut dft_dw, mut dft_dwr, mut dft_dwb) = ([0.0; 2], [0.0; 2], 0.0, 0.0);
+            match (self.law, self.mode.slip) {
+                (FrictionLaw::Regularised { v_eps_m_s }, _) => {
+                    let th = (f.v_rel_m_s / v_eps_m_s).tanh();
+                    let slope = self.mu_d * fnn * (1.0 - th * th) / v_eps_m_s;
+                    for k in 0..2 {
+                        // v_rel depends on d through the turning tangent: w . (R P / |d|).
+                        let dv_dd = (w[0] * rp[0][k] + w[1] * rp[1][k]) / dist;
+                        dft_dd[k] = self.mu_d * th * dfn_dd[k] + slope * dv_dd;
+                        dft_dw[k] = self.mu_d * th * dfn_dw[k] + slope * t[k];
+                    }
+                    dft_dwr = slope * self.r_r;
+                    dft_dwb = -slope * self.r_b;
+                }
+                (FrictionLaw::Switched, Slip::Slipping(sign)) => {
+                    for k in 0..2 {
+                        dft_dd[k] = self.mu_d * sign * dfn_dd[k];
+                        dft_dw[k] = self.mu_d * sign * dfn_dw[k];
+                    }
+                }
+                (FrictionLaw::Switched, Slip::Sticking) => {}
+            }
+            // Force on the race fc = F_n n + F_t t; the rotor gets -fc.
+            let mut dfc_dd = [[0.0; 2]; 2];
+            let mut dfc_dw = [[0.0; 2]; 2];
+            for i in 0..2 {
+                for k in 0..2 {
+                    dfc_dd[i][k] = n[i] * dfn_dd[k]
+                        + fnn * pm[i][k] / dist
+                        + t[i] * dft_dd[k]
+                        + ft * rp[i][k] / dist;
+                    dfc_dw[i][k] = n[i] * dfn_dw[k] + t[i] * dft_dw[k];
+                }
+            }
+            let race = self.series.is_none();
+            for i in 0..2 {
+                for k in 0..2 {
+                    // Rotor rows 4,5: -fc/m_r; d = p_r - p_b.
+                    j[4 + i][k] -= dfc_dd[i][k] / self.m_r;
+                    j[4 + i][4 + k] -= dfc_dw[i][k] / self.m_r;
+                    if race {
+                        j[4 + i][2 + k] += dfc_dd[i][k] / self.m_r;
+                        j[4 + i][6 + k] += dfc_dw[i][k] / self.m_r;
+                        j[6 + i][k] += dfc_dd[i][k] / self.m_b;
+                        j[6 + i][2 + k] -= dfc_dd[i][k] / self.m_b;
+                        j[6 + i][4 + k] += dfc_dw[i][k] / self.m_b;
+                        j[6 + i][6 + k] -= dfc_dw[i][k] / self.m_b;
+                    }
+                }
+                j[4 + i][8] -= t[i] * dft_dwr / self.m_r;
+                j[4 + i][9] -= t[i] * dft_dwb / self.m_r;
+                if race {
+                    j[6 + i][8] += t[i] * dft_dwr / self.m_b;
+                    j[6 + i][9] += t[i] * dft_dwb / self.m_b;
+                }
+            }
+            // Spin rows: omega_r' = -F_t r_r / J_r, omega_b' = F_t R_b / J_b.
+            for (row, scale) in [(8, -self.r_r / self.j_r), (9, self.r_b / self.j_b)] {
+                for k in 0..2 {
+                    j[row][k] += scale * dft_dd[k];
+                    j[row][4 + k] += scale * dft_dw[k];
+                    if race {
+                        j[row][2 + k] -= scale * dft_dd[k];
+                        j[row][6 + k] -= scale * dft_dw[k];
+                    }
+                }
+                j[row][8] += scale * dft_dwr;
+                j[row][9] += scale * dft_dwb;
+            }
+        }
+        if self.series.is_none() && self.mode.support {
+            let (bx, by) = (y[XB], y[YB]);
+            let r = (bx * bx + by * by).sqrt();
+            if r > 0.0 {
+                let nb = [bx / r, by / r];
+                let vb = [y[VXB], y[VYB]];
+                let vn = vb[0] * nb[0] + vb[1] * nb[1];
+                let pv = [vb[0] - nb[0] * vn, vb[1] - nb[1] * vn];
+                let pm = [[1.0 - nb[0] * nb[0], -nb[0] * nb[1]], [-nb[1] * nb[0], 1.0 - nb[1] * nb[1]]];
+                let kd = self.k2 * self.e2 * hertz::signed_pow(r, self.e2) / r;
+                let fs = f.support_n;
+                for i in 0..2 {
+                    for k in 0..2 {
+                        let dp = nb[i] * (kd * nb[k] + self.c2 * pv[k] / r) + fs * pm[i][k] / r;
+                        j[6 + i][2 + k] -= dp / self.m_b;
+                        j[6 + i][6 + k] -= self.c2 * nb[i] * nb[k] / self.m_b;
+                    }
+                }
+            }
+        }
+        Some(sj)
+    }
+
+    /// In free flight with `solver.free_flight_gap_bound`: the larger of the fixed cap and a
+    /// quarter of a lower bound on the time until the contact can close, from the gap
+    /// `s - |d|`, the relative speed and a bound on the relative acceleration (twice the
+    /// present one plus g plus the unbalance's `e omega^2`). A guard cannot cross before that
+    /// time, so no contact is stepped over; far from the race the steps grow freely.
+    fn max_step_at(&self, _t: f64, y: &[f64; N]) -> f64 {
+        let cap = self.max_step();
+        if self.mode.contact || !self.free_gap_bound {
+            return cap;
+        }
+        let f = self.forces(y);
+        let gap = -f.delta_m;
+        if gap <= 0.0 {
+            return cap;
+        }
+        let w = (y[ix::VXR] - y[ix::VXB]).hypot(y[ix::VYR] - y[ix::VYB]);
+        let a_rel = (f.acc[0] - f.acc[3]).hypot(f.acc[1] - f.acc[4]);
+        let a = 2.0 * a_rel + self.g + self.e * y[ix::WR] * y[ix::WR];
+        let t_close = 2.0 * gap / (w + (w * w + 2.0 * a * gap).sqrt());
+        cap.max(0.25 * t_close)
     }
 
     fn max_step(&self) -> f64 {

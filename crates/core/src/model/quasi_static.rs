@@ -170,6 +170,16 @@ impl SeriesSprings {
         }
     }
 
+    /// `1/e1`: with `1/e2`, the split's stiffness is `dF/dd = F / (delta/e1 + r/e2)`.
+    pub fn inv_e1(&self) -> f64 {
+        self.p
+    }
+
+    /// `1/e2`.
+    pub fn inv_e2(&self) -> f64 {
+        self.q
+    }
+
     /// Elastic energy held by both springs at a split (J): `F delta/(e1+1) + F r/(e2+1)`.
     pub fn energy_j(&self, s: &Split) -> f64 {
         s.force_n.abs() * (s.delta_m / (self.e1 + 1.0) + s.support_m / (self.e2 + 1.0))

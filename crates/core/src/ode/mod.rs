@@ -10,8 +10,10 @@
 mod dop853;
 mod dopri5;
 mod events;
+mod rosw;
 
 pub use dop853::Dop853;
+pub use rosw::Ros34pw2;
 pub use dopri5::{Dense, Dopri5, StepControl};
 pub use events::locate_crossing;
 
@@ -20,6 +22,35 @@ use std::ops::ControlFlow;
 
 /// Most guard functions one mode of a system may declare.
 pub const MAX_GUARDS: usize = 4;
+
+/// Most state components an approximate (stiff) Jacobian may couple.
+pub const MAX_STIFF: usize = 10;
+
+/// An approximate Jacobian restricted to a few state components, for the linearly implicit
+/// stepper ([`Ros34pw2`]): `jac[a][b]` approximates `d f_{idx[a]} / d y_{idx[b]}`; every
+/// entry outside these rows and columns is taken as zero.
+#[derive(Debug, Clone, Copy)]
+pub struct StiffJacobian {
+    /// The coupled components (the first `len` entries are used).
+    pub idx: [usize; MAX_STIFF],
+    /// How many components are coupled.
+    pub len: usize,
+    /// The restricted Jacobian (1/s units of the state's components).
+    pub jac: [[f64; MAX_STIFF]; MAX_STIFF],
+}
+
+impl StiffJacobian {
+    /// An empty Jacobian over the components `idx` (at most [`MAX_STIFF`]).
+    pub fn over(idx: &[usize]) -> Self {
+        let mut s = Self {
+            idx: [0; MAX_STIFF],
+            len: idx.len(),
+            jac: [[0.0; MAX_STIFF]; MAX_STIFF],
+        };
+        s.idx[..idx.len()].copy_from_slice(idx);
+        s
+    }
+}
 
 /// A first-order system `y' = f(t, y)` with a fixed-size state and mode guards.
 pub trait OdeSystem<const N: usize> {
@@ -36,6 +67,19 @@ pub trait OdeSystem<const N: usize> {
     /// Largest step allowed in the current mode (s); `f64::INFINITY` for none.
     fn max_step(&self) -> f64 {
         f64::INFINITY
+    }
+
+    /// Largest step allowed from state `(t, y)` (s); by default [`OdeSystem::max_step`].
+    fn max_step_at(&self, _t: f64, _y: &[f64; N]) -> f64 {
+        self.max_step()
+    }
+
+    /// An approximation of the stiff part of the Jacobian at `(t, y)`, for the linearly
+    /// implicit stepper. It need not be exact (a W-method keeps its order for any matrix); it
+    /// must hold the terms that make the system stiff. The default, `None`, is the zero
+    /// matrix, which turns [`Ros34pw2`] into an explicit 3rd-order Runge-Kutta method.
+    fn stiff_jacobian(&self, _t: f64, _y: &[f64; N]) -> Option<StiffJacobian> {
+        None
     }
 }
 
@@ -132,7 +176,7 @@ where
     let mut g1 = [0.0; MAX_GUARDS];
     let ng = sys.guards(*t, y, &mut g0);
     while *t < t_end {
-        let h_cap = sys.max_step().min(t_end - *t);
+        let h_cap = sys.max_step_at(*t, y).min(t_end - *t);
         let dense = stepper.step(sys, *t, y, h_cap)?;
         let t1 = dense.t1();
         let y1 = dense.y1();

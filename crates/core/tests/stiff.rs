@@ -1,0 +1,154 @@
+//! The analytic stiff Jacobian of the drop model (for the linearly implicit stepper) against
+//! central finite differences of the right-hand side, at states taken from real drops.
+
+use std::ops::ControlFlow;
+use whirlmap_core::model::{ix, DropSystem, Slip, N};
+use whirlmap_core::ode::{Observer, OdeSystem, StepView};
+use whirlmap_core::{simulate_observed, DropOptions, FrictionLaw, Scene};
+
+/// Checks the translational rows at every 10th accepted step; counts the checks per mode.
+struct Check {
+    quasi_static: bool,
+    every: usize,
+    seen: usize,
+    checked: [usize; 3],
+    worst: f64,
+}
+
+impl Observer<DropSystem, N> for Check {
+    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
+        self.seen += 1;
+        if self.seen % self.every != 0 {
+            return ControlFlow::Continue(());
+        }
+        // The sticking constraint's dependence on the state is left out by design.
+        if sys.mode.contact && sys.mode.slip == Slip::Sticking {
+            return ControlFlow::Continue(());
+        }
+        let y = step.dense.y1();
+        let sj = sys.stiff_jacobian(0.0, &y).expect("the drop model supplies a Jacobian");
+        let mut f0 = [0.0; N];
+        sys.rhs(0.0, &y, &mut f0);
+        // Rows: rotor and race accelerations; columns: every coupled component.
+        for b in 0..sj.len {
+            let c = sj.idx[b];
+            // With a massless race its translation is not a state (it stays zero).
+            if self.quasi_static && matches!(c, ix::XB | ix::YB | ix::VXB | ix::VYB) {
+                continue;
+            }
+            let scale = match c {
+                ix::XR | ix::YR | ix::XB | ix::YB => 1e-12,
+                ix::WR | ix::WB => 1e-5,
+                _ => 1e-9,
+            };
+            let (mut yp, mut ym) = (y, y);
+            yp[c] += scale;
+            ym[c] -= scale;
+            let (mut fp, mut fm) = ([0.0; N], [0.0; N]);
+            sys.rhs(0.0, &yp, &mut fp);
+            sys.rhs(0.0, &ym, &mut fm);
+            for a in 4..8 {
+                let r = sj.idx[a];
+                if self.quasi_static && a >= 6 {
+                    continue;
+                }
+                let fd = (fp[r] - fm[r]) / (2.0 * scale);
+                // Row scale: the largest analytic entry in the row over that column kind.
+                let row_max = (0..sj.len)
+                    .map(|k| sj.jac[a][k].abs())
+                    .fold(1.0, f64::max);
+                let err = (sj.jac[a][b] - fd).abs() / row_max;
+                self.worst = self.worst.max(err);
+                assert!(
+                    err < 1e-4,
+                    "row {r} col {c}: analytic {:e} fd {fd:e} (row max {row_max:e}), mode {:?}",
+                    sj.jac[a][b],
+                    sys.mode
+                );
+            }
+        }
+        self.checked[if !sys.mode.contact { 0 } else { 1 }] += 1;
+        ControlFlow::Continue(())
+    }
+}
+
+fn check(scene: Scene) -> Check {
+    let mut c = Check {
+        quasi_static: scene.quasi_static_race,
+        every: 10,
+        seen: 0,
+        checked: [0; 3],
+        worst: 0.0,
+    };
+    let opts = DropOptions {
+        duration_s: 0.05,
+        ..Default::default()
+    };
+    simulate_observed(&scene, &opts, &mut c).unwrap();
+    c
+}
+
+#[test]
+fn jacobian_matches_finite_differences_in_free_flight_and_slipping_contact() {
+    let mut s = Scene::paper();
+    s.mu_dynamic = 0.3;
+    let c = check(s);
+    assert!(c.checked[0] > 3 && c.checked[1] > 3, "{:?}", c.checked);
+    eprintln!("switched law: worst {:e}, checks {:?}", c.worst, c.checked);
+}
+
+#[test]
+fn jacobian_matches_finite_differences_with_regularised_friction_and_quasi_static_race() {
+    let mut s = Scene::paper();
+    s.mu_dynamic = 0.3;
+    s.friction_law = FrictionLaw::Regularised { v_eps_m_s: 1e-3 };
+    let c = check(s.clone());
+    assert!(c.checked[1] > 3, "{:?}", c.checked);
+    s.friction_law = FrictionLaw::Switched;
+    s.quasi_static_race = true;
+    let c = check(s);
+    assert!(c.checked[1] > 3, "{:?}", c.checked);
+}
+
+fn drop_with(method: whirlmap_core::Method, rtol: f64, gap: bool) -> whirlmap_core::DropReport {
+    let mut s = Scene::paper();
+    s.solver.method = method;
+    s.solver.rtol = rtol;
+    s.solver.free_flight_gap_bound = gap;
+    let opts = DropOptions {
+        duration_s: 0.1,
+        ..Default::default()
+    };
+    whirlmap_core::simulate(&s, &opts).unwrap()
+}
+
+/// The implicit stepper with the free-flight gap bound against DOPRI5 at rtol 1e-9 on the
+/// bouncing phase (13 impacts, free flights, friction switches): same impacts and class,
+/// forces converging as the tolerance tightens, and an energy audit that closes.
+#[test]
+fn implicit_stepper_converges_to_the_reference_on_a_bouncing_drop() {
+    use whirlmap_core::Method;
+    let reference = drop_with(Method::Dopri5, 1e-9, false);
+    let rf = &reference.features;
+    let mut last_err = f64::INFINITY;
+    for rtol in [1e-4, 1e-6, 1e-8] {
+        let r = drop_with(Method::Ros34pw2, rtol, true);
+        let f = &r.features;
+        let err = ((f.first_contact_force_n - rf.first_contact_force_n).abs()
+            / rf.first_contact_force_n)
+            .max((f.max_contact_force_n - rf.max_contact_force_n).abs() / rf.max_contact_force_n);
+        eprintln!("rtol {rtol:e}: force error {err:e}, {:?}, residual {:e}", r.stats, r.energy.residual_rel);
+        assert_eq!(f.impacts, rf.impacts, "rtol {rtol:e}");
+        assert!(
+            (f.first_contact_time_s - rf.first_contact_time_s).abs() < 1e-6 * rf.first_contact_time_s,
+            "first contact {} vs {}",
+            f.first_contact_time_s,
+            rf.first_contact_time_s
+        );
+        assert!(err < 1e-3, "rtol {rtol:e}: force error {err:e}");
+        assert!(r.energy.residual_rel < 1e-5, "rtol {rtol:e}: {:?}", r.energy);
+        assert!(err < last_err || err < 1e-8, "no convergence: {err:e} after {last_err:e}");
+        last_err = err;
+    }
+    assert!(last_err < 1e-6, "rtol 1e-8: force error {last_err:e}");
+}
