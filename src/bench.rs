@@ -45,10 +45,34 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         ("pendulum 8000 r/min mu 0.1, 1 s", 8000.0, 0.1, false, None),
         ("same, thermal model on", 8000.0, 0.1, true, None),
         ("whirl 8000 r/min mu 0.4 (rule)", 8000.0, 0.4, false, None),
-        ("pendulum, ros34pw2+gap rtol 1e-4", 8000.0, 0.1, false, Some(1e-4)),
-        ("whirl, ros34pw2+gap rtol 1e-4", 8000.0, 0.4, false, Some(1e-4)),
-        ("pendulum, ros34pw2+gap rtol 1e-5", 8000.0, 0.1, false, Some(1e-5)),
-        ("whirl, ros34pw2+gap rtol 1e-5", 8000.0, 0.4, false, Some(1e-5)),
+        (
+            "pendulum, ros34pw2+gap rtol 1e-4",
+            8000.0,
+            0.1,
+            false,
+            Some(1e-4),
+        ),
+        (
+            "whirl, ros34pw2+gap rtol 1e-4",
+            8000.0,
+            0.4,
+            false,
+            Some(1e-4),
+        ),
+        (
+            "pendulum, ros34pw2+gap rtol 1e-5",
+            8000.0,
+            0.1,
+            false,
+            Some(1e-5),
+        ),
+        (
+            "whirl, ros34pw2+gap rtol 1e-5",
+            8000.0,
+            0.4,
+            false,
+            Some(1e-5),
+        ),
     ];
     for (name, speed, mu, thermal, implicit) in cases {
         let mut scene = Scene::paper();

@@ -5,7 +5,8 @@ use crate::error::{InvalidParameter, SolveError};
 use crate::model::{ix, DropSystem, Mode, Slip, N};
 use crate::monitor::{Features, Monitor};
 use crate::ode::{
-    integrate, Dop853, Dopri5, Ros34pw2, NoObserver, Observer, Stats, StepControl, StepView, Stepper, Stop,
+    integrate, Dop853, Dopri5, NoObserver, Observer, Ros34pw2, Stats, StepControl, StepView,
+    Stepper, Stop,
 };
 use crate::orbit::Orbit;
 use crate::scene::{Method, Scene};

@@ -81,7 +81,6 @@ pub struct SolverSettings {
     pub free_flight_gap_bound: bool,
 }
 
-
 impl Default for SolverSettings {
     fn default() -> Self {
         Self {

@@ -26,7 +26,9 @@ impl Observer<DropSystem, N> for Check {
             return ControlFlow::Continue(());
         }
         let y = step.dense.y1();
-        let sj = sys.stiff_jacobian(0.0, &y).expect("the drop model supplies a Jacobian");
+        let sj = sys
+            .stiff_jacobian(0.0, &y)
+            .expect("the drop model supplies a Jacobian");
         let mut f0 = [0.0; N];
         sys.rhs(0.0, &y, &mut f0);
         // Rows: rotor and race accelerations; columns: every coupled component.
@@ -54,9 +56,7 @@ impl Observer<DropSystem, N> for Check {
                 }
                 let fd = (fp[r] - fm[r]) / (2.0 * scale);
                 // Row scale: the largest analytic entry in the row over that column kind.
-                let row_max = (0..sj.len)
-                    .map(|k| sj.jac[a][k].abs())
-                    .fold(1.0, f64::max);
+                let row_max = (0..sj.len).map(|k| sj.jac[a][k].abs()).fold(1.0, f64::max);
                 let err = (sj.jac[a][b] - fd).abs() / row_max;
                 self.worst = self.worst.max(err);
                 assert!(
@@ -137,17 +137,28 @@ fn implicit_stepper_converges_to_the_reference_on_a_bouncing_drop() {
         let err = ((f.first_contact_force_n - rf.first_contact_force_n).abs()
             / rf.first_contact_force_n)
             .max((f.max_contact_force_n - rf.max_contact_force_n).abs() / rf.max_contact_force_n);
-        eprintln!("rtol {rtol:e}: force error {err:e}, {:?}, residual {:e}", r.stats, r.energy.residual_rel);
+        eprintln!(
+            "rtol {rtol:e}: force error {err:e}, {:?}, residual {:e}",
+            r.stats, r.energy.residual_rel
+        );
         assert_eq!(f.impacts, rf.impacts, "rtol {rtol:e}");
         assert!(
-            (f.first_contact_time_s - rf.first_contact_time_s).abs() < 1e-6 * rf.first_contact_time_s,
+            (f.first_contact_time_s - rf.first_contact_time_s).abs()
+                < 1e-6 * rf.first_contact_time_s,
             "first contact {} vs {}",
             f.first_contact_time_s,
             rf.first_contact_time_s
         );
         assert!(err < 1e-3, "rtol {rtol:e}: force error {err:e}");
-        assert!(r.energy.residual_rel < 1e-5, "rtol {rtol:e}: {:?}", r.energy);
-        assert!(err < last_err || err < 1e-8, "no convergence: {err:e} after {last_err:e}");
+        assert!(
+            r.energy.residual_rel < 1e-5,
+            "rtol {rtol:e}: {:?}",
+            r.energy
+        );
+        assert!(
+            err < last_err || err < 1e-8,
+            "no convergence: {err:e} after {last_err:e}"
+        );
         last_err = err;
     }
     assert!(last_err < 1e-6, "rtol 1e-8: force error {last_err:e}");

@@ -505,7 +505,10 @@ impl OdeSystem<N> for DropSystem {
             let wn = w[0] * n[0] + w[1] * n[1];
             let pw = [w[0] - n[0] * wn, w[1] - n[1] * wn];
             // P = I - n n^T and R P with R the quarter turn (t = R n).
-            let pm = [[1.0 - n[0] * n[0], -n[0] * n[1]], [-n[1] * n[0], 1.0 - n[1] * n[1]]];
+            let pm = [
+                [1.0 - n[0] * n[0], -n[0] * n[1]],
+                [-n[1] * n[0], 1.0 - n[1] * n[1]],
+            ];
             let rp = [[-pm[1][0], -pm[1][1]], [pm[0][0], pm[0][1]]];
             let (kd, c) = match &self.series {
                 Some(ss) => {
@@ -620,7 +623,10 @@ impl OdeSystem<N> for DropSystem {
                 let vb = [y[VXB], y[VYB]];
                 let vn = vb[0] * nb[0] + vb[1] * nb[1];
                 let pv = [vb[0] - nb[0] * vn, vb[1] - nb[1] * vn];
-                let pm = [[1.0 - nb[0] * nb[0], -nb[0] * nb[1]], [-nb[1] * nb[0], 1.0 - nb[1] * nb[1]]];
+                let pm = [
+                    [1.0 - nb[0] * nb[0], -nb[0] * nb[1]],
+                    [-nb[1] * nb[0], 1.0 - nb[1] * nb[1]],
+                ];
                 let kd = self.k2 * self.e2 * hertz::signed_pow(r, self.e2) / r;
                 let fs = f.support_n;
                 for i in 0..2 {

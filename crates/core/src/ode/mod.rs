@@ -13,9 +13,9 @@ mod events;
 mod rosw;
 
 pub use dop853::Dop853;
-pub use rosw::Ros34pw2;
 pub use dopri5::{Dense, Dopri5, StepControl};
 pub use events::locate_crossing;
+pub use rosw::Ros34pw2;
 
 use crate::error::SolveError;
 use std::ops::ControlFlow;

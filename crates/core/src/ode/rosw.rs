@@ -184,7 +184,13 @@ impl<const N: usize> Ros34pw2<N> {
 
     /// One trial step of size `h` with `self.lu` factored for it: the new state, the error
     /// norm.
-    fn attempt<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N], h: f64) -> ([f64; N], f64) {
+    fn attempt<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64; N],
+        h: f64,
+    ) -> ([f64; N], f64) {
         let lu = &self.lu;
         let mut k = [[0.0; N]; 4];
         // Stage 1.
@@ -336,7 +342,8 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
                 self.f0 = f1;
                 self.stats.steps += 1;
                 if !fixed {
-                    let fac = (err.max(1e-10).powf(EXPO) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+                    let fac =
+                        (err.max(1e-10).powf(EXPO) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
                     let mut h_new = h / fac;
                     if rejected_last {
                         h_new = h_new.min(h);
@@ -447,7 +454,10 @@ mod tests {
         };
         let (e1, e2) = (err(0.02), err(0.01));
         let order = (e1 / e2).log2();
-        assert!((order - 3.0).abs() < 0.2, "observed order {order} ({e1:e}, {e2:e})");
+        assert!(
+            (order - 3.0).abs() < 0.2,
+            "observed order {order} ({e1:e}, {e2:e})"
+        );
     }
 
     #[test]
@@ -455,8 +465,15 @@ mod tests {
         let run = |with_jac: bool| {
             let mut st = Ros34pw2::new(ctl::<4>(1e-6, None));
             let (mut t, mut y) = (0.0, [1.0, 0.0, 0.0, 0.0]);
-            integrate(&Stiff { with_jac }, &mut st, &mut t, &mut y, 10.0, &mut NoObserver)
-                .unwrap();
+            integrate(
+                &Stiff { with_jac },
+                &mut st,
+                &mut t,
+                &mut y,
+                10.0,
+                &mut NoObserver,
+            )
+            .unwrap();
             (y, st.stats)
         };
         let (y_imp, s_imp) = run(true);
