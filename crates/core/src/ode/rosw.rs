@@ -17,7 +17,7 @@
 //! stage.
 
 use super::dopri5::initial_step;
-use super::{Dense, OdeSystem, Stats, StepControl, Stepper, MAX_STIFF};
+use super::{Dense, OdeSystem, Stats, StepControl, Stepper, StiffJacobian, MAX_STIFF};
 use crate::error::SolveError;
 
 const GAMMA: f64 = 4.358_665_215_084_590_0e-1;
@@ -47,10 +47,8 @@ const BHAT: [f64; 4] = [
 /// `W = I - h gamma J` on the stiff components, LU-factored with partial pivoting.
 #[derive(Debug, Clone, Copy)]
 struct Lu {
-    n: usize,
-    idx: [usize; MAX_STIFF],
-    /// `J` itself, for the `J v` products of the stage right-hand sides.
-    jac: [[f64; MAX_STIFF]; MAX_STIFF],
+    /// `J` itself, for the `J v` products of the stage right-hand sides (`len` 0: none).
+    j: StiffJacobian,
     lu: [[f64; MAX_STIFF]; MAX_STIFF],
     piv: [usize; MAX_STIFF],
 }
@@ -58,9 +56,7 @@ struct Lu {
 impl Lu {
     fn identity() -> Self {
         Self {
-            n: 0,
-            idx: [0; MAX_STIFF],
-            jac: [[0.0; MAX_STIFF]; MAX_STIFF],
+            j: StiffJacobian::over(&[]),
             lu: [[0.0; MAX_STIFF]; MAX_STIFF],
             piv: [0; MAX_STIFF],
         }
@@ -68,10 +64,10 @@ impl Lu {
 
     /// Factors `I - hg J`; false if singular (the caller shrinks the step).
     fn factor(&mut self, hg: f64) -> bool {
-        let n = self.n;
+        let n = self.j.len;
         for a in 0..n {
             for b in 0..n {
-                self.lu[a][b] = -hg * self.jac[a][b];
+                self.lu[a][b] = -hg * self.j.jac[a][b];
             }
             self.lu[a][a] += 1.0;
         }
@@ -105,13 +101,13 @@ impl Lu {
     /// identity there).
     #[inline]
     fn solve<const N: usize>(&self, v: &mut [f64; N]) {
-        let n = self.n;
+        let n = self.j.len;
         if n == 0 {
             return;
         }
         let mut x = [0.0; MAX_STIFF];
         for a in 0..n {
-            x[a] = v[self.idx[a]];
+            x[a] = v[self.j.idx[a]];
         }
         // Row swaps first (the factor swapped whole rows, multipliers included), then the
         // unit lower and the upper triangular solves.
@@ -132,19 +128,19 @@ impl Lu {
             x[k] = s / self.lu[k][k];
         }
         for a in 0..n {
-            v[self.idx[a]] = x[a];
+            v[self.j.idx[a]] = x[a];
         }
     }
 
     /// Adds `scale * J u` into `out`.
     #[inline]
     fn add_jv<const N: usize>(&self, scale: f64, u: &[f64; N], out: &mut [f64; N]) {
-        for a in 0..self.n {
+        for a in 0..self.j.len {
             let mut s = 0.0;
-            for b in 0..self.n {
-                s += self.jac[a][b] * u[self.idx[b]];
+            for b in 0..self.j.len {
+                s += self.j.jac[a][b] * u[self.j.idx[b]];
             }
-            out[self.idx[a]] += scale * s;
+            out[self.j.idx[a]] += scale * s;
         }
     }
 }
@@ -288,14 +284,9 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
         const FAC_MAX: f64 = 6.0;
         // The error estimate is O(h^3): the controller's exponent.
         const EXPO: f64 = 1.0 / 3.0;
-        match sys.stiff_jacobian(t, y) {
-            Some(j) => {
-                self.lu.n = j.len;
-                self.lu.idx = j.idx;
-                self.lu.jac = j.jac;
-            }
-            None => self.lu.n = 0,
-        }
+        self.lu.j = sys
+            .stiff_jacobian(t, y)
+            .unwrap_or_else(|| StiffJacobian::over(&[]));
         let mut rejected_last = false;
         loop {
             if self.stats.steps + self.stats.rejected >= self.ctl.max_attempts {
