@@ -64,7 +64,17 @@ impl Lu {
 
     /// Factors `I - hg J`; false if singular (the caller shrinks the step).
     fn factor(&mut self, hg: f64) -> bool {
-        let n = self.j.len;
+        // The full size gets its own copy with constant loop bounds (unrolled, no bounds
+        // checks): the usual case, and half the stepper's time before this split.
+        if self.j.len == MAX_STIFF {
+            self.factor_n(hg, MAX_STIFF)
+        } else {
+            self.factor_n(hg, self.j.len)
+        }
+    }
+
+    #[inline(always)]
+    fn factor_n(&mut self, hg: f64, n: usize) -> bool {
         for a in 0..n {
             for b in 0..n {
                 self.lu[a][b] = -hg * self.j.jac[a][b];
@@ -101,10 +111,15 @@ impl Lu {
     /// identity there).
     #[inline]
     fn solve<const N: usize>(&self, v: &mut [f64; N]) {
-        let n = self.j.len;
-        if n == 0 {
-            return;
+        match self.j.len {
+            0 => {}
+            MAX_STIFF => self.solve_n(v, MAX_STIFF),
+            n => self.solve_n(v, n),
         }
+    }
+
+    #[inline(always)]
+    fn solve_n<const N: usize>(&self, v: &mut [f64; N], n: usize) {
         let mut x = [0.0; MAX_STIFF];
         for a in 0..n {
             x[a] = v[self.j.idx[a]];
@@ -135,10 +150,23 @@ impl Lu {
     /// Adds `scale * J u` into `out`.
     #[inline]
     fn add_jv<const N: usize>(&self, scale: f64, u: &[f64; N], out: &mut [f64; N]) {
-        for a in 0..self.j.len {
+        if self.j.len == MAX_STIFF {
+            self.add_jv_n(scale, u, out, MAX_STIFF)
+        } else {
+            self.add_jv_n(scale, u, out, self.j.len)
+        }
+    }
+
+    #[inline(always)]
+    fn add_jv_n<const N: usize>(&self, scale: f64, u: &[f64; N], out: &mut [f64; N], n: usize) {
+        let mut ug = [0.0; MAX_STIFF];
+        for b in 0..n {
+            ug[b] = u[self.j.idx[b]];
+        }
+        for a in 0..n {
             let mut s = 0.0;
-            for b in 0..self.j.len {
-                s += self.j.jac[a][b] * u[self.j.idx[b]];
+            for b in 0..n {
+                s += self.j.jac[a][b] * ug[b];
             }
             out[self.j.idx[a]] += scale * s;
         }
