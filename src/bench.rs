@@ -23,6 +23,18 @@ pub struct BenchArgs {
 const COAST_DOWN_SCENE: &str = include_str!("../scenes/coast-down.json");
 const RUNAWAY_SCENE: &str = include_str!("../scenes/runaway.json");
 
+/// How a bench row departs from the default scene.
+#[derive(Clone, Copy)]
+enum Numerics {
+    /// The scene's defaults (DOPRI5, rtol 1e-5, radial support damper).
+    Default,
+    /// The isotropic support damper, default numerics.
+    Iso,
+    /// ROS34PW2 with the gap bound at `rtol`; with `race`, also the isotropic support damper
+    /// and that factor on the race's absolute tolerances.
+    Ros { rtol: f64, race: Option<f64> },
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
     v[v.len() / 2]
@@ -36,52 +48,110 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         Scene::paper().solver.rtol
     );
     println!(
-        "{:<34} {:>10} {:>11} {:>9} {:>8} {:>7} {:>12}",
+        "{:<36} {:>10} {:>11} {:>9} {:>8} {:>7} {:>12}",
         "case", "wall ms", "RHS evals", "steps", "rejected", "events", "ns/RHS eval"
     );
-    // The last four rows: the linearly implicit ROS34PW2 with the free-flight gap bound
-    // (README, "Speed against accuracy"), at two tolerances.
+    // Then the linearly implicit ROS34PW2 with the free-flight gap bound (README, "Speed
+    // against accuracy") at two tolerances, and the isotropic support damper
+    // (`support_damping_isotropic`, a model choice) with DOPRI5 and with ROS34PW2, the gap
+    // bound and the race's absolute tolerances x1000 (`solver.race_atol_scale`).
+    let plain = Numerics::Default;
+    let ros = |rtol| Numerics::Ros { rtol, race: None };
+    let iso_ros = |rtol| Numerics::Ros {
+        rtol,
+        race: Some(1000.0),
+    };
     let cases = [
-        ("pendulum 8000 r/min mu 0.1, 1 s", 8000.0, 0.1, false, None),
-        ("same, thermal model on", 8000.0, 0.1, true, None),
-        ("whirl 8000 r/min mu 0.4 (rule)", 8000.0, 0.4, false, None),
+        ("pendulum 8000 r/min mu 0.1, 1 s", 8000.0, 0.1, false, plain),
+        ("same, thermal model on", 8000.0, 0.1, true, plain),
+        ("whirl 8000 r/min mu 0.4 (rule)", 8000.0, 0.4, false, plain),
         (
             "pendulum, ros34pw2+gap rtol 1e-4",
             8000.0,
             0.1,
             false,
-            Some(1e-4),
+            ros(1e-4),
         ),
         (
             "whirl, ros34pw2+gap rtol 1e-4",
             8000.0,
             0.4,
             false,
-            Some(1e-4),
+            ros(1e-4),
         ),
         (
             "pendulum, ros34pw2+gap rtol 1e-5",
             8000.0,
             0.1,
             false,
-            Some(1e-5),
+            ros(1e-5),
         ),
         (
             "whirl, ros34pw2+gap rtol 1e-5",
             8000.0,
             0.4,
             false,
-            Some(1e-5),
+            ros(1e-5),
+        ),
+        (
+            "iso: pendulum, dopri5 rtol 1e-5",
+            8000.0,
+            0.1,
+            false,
+            Numerics::Iso,
+        ),
+        (
+            "iso: whirl, dopri5 rtol 1e-5",
+            8000.0,
+            0.4,
+            false,
+            Numerics::Iso,
+        ),
+        (
+            "iso: pendulum, ros+race x1000 1e-4",
+            8000.0,
+            0.1,
+            false,
+            iso_ros(1e-4),
+        ),
+        (
+            "iso: whirl, ros+race x1000 1e-4",
+            8000.0,
+            0.4,
+            false,
+            iso_ros(1e-4),
+        ),
+        (
+            "iso: pendulum, ros+race x1000 1e-5",
+            8000.0,
+            0.1,
+            false,
+            iso_ros(1e-5),
+        ),
+        (
+            "iso: whirl, ros+race x1000 1e-5",
+            8000.0,
+            0.4,
+            false,
+            iso_ros(1e-5),
         ),
     ];
-    for (name, speed, mu, thermal, implicit) in cases {
+    for (name, speed, mu, thermal, numerics) in cases {
         let mut scene = Scene::paper();
         scene.speed_rpm = speed;
         scene.mu_dynamic = mu;
-        if let Some(rtol) = implicit {
-            scene.solver.method = whirlmap_core::Method::Ros34pw2;
-            scene.solver.free_flight_gap_bound = true;
-            scene.solver.rtol = rtol;
+        match numerics {
+            Numerics::Default => {}
+            Numerics::Iso => scene.support_damping_isotropic = true,
+            Numerics::Ros { rtol, race } => {
+                scene.solver.method = whirlmap_core::Method::Ros34pw2;
+                scene.solver.free_flight_gap_bound = true;
+                scene.solver.rtol = rtol;
+                if let Some(f) = race {
+                    scene.support_damping_isotropic = true;
+                    scene.solver.race_atol_scale = f;
+                }
+            }
         }
         if thermal {
             scene.thermal = Some(whirlmap_core::ThermalParams::default());
@@ -149,7 +219,7 @@ fn print_row(name: &str, wall_ms: f64, r: &DropReport) {
         ""
     };
     println!(
-        "{:<34} {:>10.2} {:>11} {:>9} {:>8} {:>7} {:>12.0}{note}",
+        "{:<36} {:>10.2} {:>11} {:>9} {:>8} {:>7} {:>12.0}{note}",
         name,
         wall_ms,
         r.stats.rhs_evals,

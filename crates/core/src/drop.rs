@@ -195,6 +195,9 @@ pub(crate) fn tolerances(scene: &Scene, sys: &DropSystem) -> StepControl<N> {
     for i in [ix::WR, ix::WB] {
         atol[i] = w;
     }
+    for i in [ix::XB, ix::YB, ix::VXB, ix::VYB] {
+        atol[i] *= s.race_atol_scale;
+    }
     for i in [ix::E_FRIC, ix::E_DAMP, ix::E_DRAG] {
         atol[i] = en;
     }

@@ -75,10 +75,26 @@ pub struct SolverSettings {
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a
-    /// bound on the relative acceleration). Default false (the fixed cap alone); the
-    /// `standard` preset turns it on. Omitted from the canonical JSON while false.
+    /// bound on the relative acceleration). Default false (the fixed cap alone). Omitted
+    /// from the canonical JSON while false.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub free_flight_gap_bound: bool,
+    /// Factor on the absolute tolerances of the race's translation (its centre's position
+    /// and velocity). The race centre is a fast variable held by two stiff springs (its own
+    /// modes at 3-16 kHz): with its support damped in every direction
+    /// (`support_damping_isotropic`) and an L-stable stepper (`ros34pw2`) its local errors
+    /// decay instead of accumulating, and the default absolute tolerance (that of the
+    /// rotor, 1e-6 m and `rtol * sqrt(2 g s) / 100` scaled by rtol) is what bounds the
+    /// implicit step in contact. The accuracy this costs is measured by `whirlmap accuracy`
+    /// (README, "Speed against accuracy"). Default 1; allowed [1, 1e4]. Omitted from the
+    /// canonical JSON while 1.
+    #[serde(skip_serializing_if = "is_one")]
+    pub race_atol_scale: f64,
+}
+
+// Exact comparison on purpose: only the default is left out of the JSON.
+fn is_one(v: &f64) -> bool {
+    *v == 1.0
 }
 
 impl Default for SolverSettings {
@@ -92,6 +108,7 @@ impl Default for SolverSettings {
             max_events: 2_000_000,
             method: Method::Dopri5,
             free_flight_gap_bound: false,
+            race_atol_scale: 1.0,
         }
     }
 }
@@ -173,6 +190,14 @@ pub struct Scene {
     pub support_exponent: f64,
     /// Race-on-balls damping c2 (N s/m). Table 4: 750. Allowed >= 0.
     pub support_damping_n_s_per_m: f64,
+    /// The support damper c2 acts on the race's whole velocity (an isotropic damping matrix
+    /// c2 I) instead of its radial rate only. A ball set whose balls each damp their own
+    /// deformation rate sums to an isotropic matrix over a half-loaded zone (sum of cos^2 =
+    /// sum of sin^2), so this damps the race's tangential vibration on its support (about
+    /// 3 kHz), which the radial damper leaves undamped. Default false (eq. 7 read as a
+    /// radial damper); omitted from the canonical JSON while false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub support_damping_isotropic: bool,
 
     // ---- Palmgren drag of the touchdown bearing (eqs. 11-13) ------------------------------
     /// Drag torque on the race switched on. Default true.
@@ -244,6 +269,7 @@ impl Scene {
         "release_velocity_m_s",
         "race_speed_rad_s",
         "quasi_static_race",
+        "support_damping_isotropic",
         "stop_speed_rpm",
         "thermal",
     ];
@@ -274,6 +300,7 @@ impl Scene {
             support_stiffness_n_per_m_e: K2_TABLE4_N_PER_M15,
             support_exponent: 1.5,
             support_damping_n_s_per_m: 750.0,
+            support_damping_isotropic: false,
             drag_enabled: true,
             palmgren_f0: 2.0,
             lubricant_viscosity_mm2_s: 22.0,
@@ -522,6 +549,12 @@ impl Scene {
             s.min_step_s,
             s.min_step_s > 0.0 && s.min_step_s < s.free_flight_max_step_s,
             "(0, free_flight_max_step_s)",
+        )?;
+        check(
+            "solver.race_atol_scale",
+            s.race_atol_scale,
+            (1.0..=1e4).contains(&s.race_atol_scale),
+            "[1, 1e4]",
         )?;
         if s.max_step_attempts == 0 {
             return Err(InvalidParameter::new("solver.max_step_attempts", 0, ">= 1"));

@@ -110,6 +110,19 @@ fn jacobian_matches_finite_differences_with_regularised_friction_and_quasi_stati
     assert!(c.checked[1] > 3, "{:?}", c.checked);
 }
 
+#[test]
+fn jacobian_matches_finite_differences_with_isotropic_support_damping() {
+    let mut s = Scene::paper();
+    s.mu_dynamic = 0.3;
+    s.support_damping_isotropic = true;
+    let c = check(s);
+    assert!(c.checked[0] > 3 && c.checked[1] > 3, "{:?}", c.checked);
+    eprintln!(
+        "isotropic support damper: worst {:e}, checks {:?}",
+        c.worst, c.checked
+    );
+}
+
 fn drop_with(method: whirlmap_core::Method, rtol: f64, gap: bool) -> whirlmap_core::DropReport {
     let mut s = Scene::paper();
     s.solver.method = method;

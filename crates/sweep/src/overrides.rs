@@ -46,6 +46,8 @@ pub fn apply_assignment(scene: &mut Scene, assignment: &str) -> Result<(), Overr
 fn show_optional_fields(root: &mut Value) {
     if let Value::Object(m) = root {
         m.entry("quasi_static_race").or_insert(Value::Bool(false));
+        m.entry("support_damping_isotropic")
+            .or_insert(Value::Bool(false));
         m.entry("stop_speed_rpm").or_insert(Value::Null);
         for key in ["release_offset_m", "release_velocity_m_s"] {
             m.entry(key).or_insert(serde_json::json!([0.0, 0.0]));
@@ -59,6 +61,9 @@ fn show_optional_fields(root: &mut Value) {
             solver
                 .entry("free_flight_gap_bound")
                 .or_insert(Value::Bool(false));
+            solver
+                .entry("race_atol_scale")
+                .or_insert(serde_json::json!(1.0));
         }
     }
 }

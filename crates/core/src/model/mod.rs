@@ -124,6 +124,8 @@ pub struct DropSystem {
     k2: f64,
     e2: f64,
     c2: f64,
+    /// Tangential support damping (N s/m): c2 with `support_damping_isotropic`, else 0.
+    c2_t: f64,
     mu_d: f64,
     mu_s: f64,
     law: FrictionLaw,
@@ -166,6 +168,11 @@ impl DropSystem {
             k2: scene.support_stiffness_n_per_m_e,
             e2: scene.support_exponent,
             c2: scene.support_damping_n_s_per_m,
+            c2_t: if scene.support_damping_isotropic {
+                scene.support_damping_n_s_per_m
+            } else {
+                0.0
+            },
             mu_d: scene.mu_dynamic,
             mu_s: scene.mu_static(),
             law: scene.friction_law,
@@ -319,6 +326,7 @@ impl DropSystem {
         let r = (bx * bx + by * by).sqrt();
         let mut support_vec = [0.0; 2];
         let mut r_dot = 0.0;
+        let mut tangential_power_w = 0.0;
         if self.series.is_some() {
             // The support carries the contact force; its guard never fires.
             f.support_raw_n = self.f_ref_b;
@@ -330,6 +338,13 @@ impl DropSystem {
             if mode.support {
                 f.support_n = f.support_raw_n;
                 support_vec = [-f.support_n * nb[0], -f.support_n * nb[1]];
+                if self.c2_t > 0.0 {
+                    // Isotropic damper: c2 also on the race velocity across nb.
+                    let vt = [y[ix::VXB] - nb[0] * r_dot, y[ix::VYB] - nb[1] * r_dot];
+                    support_vec[0] -= self.c2_t * vt[0];
+                    support_vec[1] -= self.c2_t * vt[1];
+                    tangential_power_w = self.c2_t * (vt[0] * vt[0] + vt[1] * vt[1]);
+                }
             }
         }
 
@@ -372,7 +387,7 @@ impl DropSystem {
         } else {
             0.0
         } + if mode.support {
-            self.c2 * r_dot * r_dot
+            self.c2 * r_dot * r_dot + tangential_power_w
         } else {
             0.0
         };
@@ -634,6 +649,10 @@ impl OdeSystem<N> for DropSystem {
                         let dp = nb[i] * (kd * nb[k] + self.c2 * pv[k] / r) + fs * pm[i][k] / r;
                         j[6 + i][2 + k] -= dp / self.m_b;
                         j[6 + i][6 + k] -= self.c2 * nb[i] * nb[k] / self.m_b;
+                        // Tangential damper -c2_t (v - nb (nb.v)): its turning with nb.
+                        j[6 + i][2 + k] +=
+                            self.c2_t * (pm[i][k] * vn + nb[i] * pv[k]) / (r * self.m_b);
+                        j[6 + i][6 + k] -= self.c2_t * pm[i][k] / self.m_b;
                     }
                 }
             }

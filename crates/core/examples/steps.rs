@@ -1,0 +1,78 @@
+//! Ad-hoc diagnostic: accepted steps of a 1 s drop per 50 ms window and per mode (free,
+//! sticking, slipping), to see where a stepper spends its steps.
+//! `cargo run --release -p whirlmap-core --example steps -- [rtol=1e-4] [ros=true]
+//! [gap=true] [iso=true] [race=1000] [mu=0.1] [rpm=8000]`.
+use std::ops::ControlFlow;
+use whirlmap_core::ode::{Observer, StepView};
+use whirlmap_core::*;
+struct Rec(Vec<(f64, f64, bool, i32)>);
+impl Observer<model::DropSystem, { model::N }> for Rec {
+    fn on_step(
+        &mut self,
+        sys: &model::DropSystem,
+        s: &StepView<'_, { model::N }>,
+    ) -> ControlFlow<()> {
+        let m = sys.mode;
+        let sl = match m.slip {
+            model::Slip::Sticking => 0,
+            model::Slip::Slipping(x) => x as i32,
+        };
+        self.0.push((s.dense.t0(), s.dense.t1(), m.contact, sl));
+        ControlFlow::Continue(())
+    }
+}
+fn main() {
+    let mut s = Scene::paper();
+    for a in std::env::args().skip(1) {
+        let (k, v) = a.split_once('=').unwrap();
+        match k {
+            "rtol" => s.solver.rtol = v.parse().unwrap(),
+            "iso" => s.support_damping_isotropic = v.parse().unwrap(),
+            "gap" => s.solver.free_flight_gap_bound = v.parse().unwrap(),
+            "ros" => {
+                if v == "true" {
+                    s.solver.method = scene::Method::Ros34pw2
+                }
+            }
+            "race" => s.solver.race_atol_scale = v.parse().unwrap(),
+            "mu" => s.mu_dynamic = v.parse().unwrap(),
+            "rpm" => s.speed_rpm = v.parse().unwrap(),
+            _ => panic!("{k}"),
+        }
+    }
+    let mut rec = Rec(Vec::new());
+    let r = simulate_observed(
+        &s,
+        &DropOptions {
+            duration_s: 1.0,
+            ..Default::default()
+        },
+        &mut rec,
+    )
+    .unwrap();
+    println!("{:?} stop: {:?}", r.stats, r.stop_reason);
+    let mut w = [[0usize; 4]; 20];
+    for &(t0, _t1, c, sl) in &rec.0 {
+        let b = ((t0 / 0.05) as usize).min(19);
+        let k = if !c {
+            0
+        } else if sl == 0 {
+            1
+        } else {
+            2
+        };
+        w[b][k] += 1;
+        w[b][3] += 1;
+    }
+    println!("window  free  stick  slip  total");
+    for (i, r) in w.iter().enumerate() {
+        println!(
+            "{:>4} ms {:>6} {:>6} {:>6} {:>6}",
+            i * 50,
+            r[0],
+            r[1],
+            r[2],
+            r[3]
+        );
+    }
+}
