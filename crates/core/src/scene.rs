@@ -83,9 +83,9 @@ pub struct SolverSettings {
     /// and velocity). The race centre is a fast variable held by two stiff springs (its own
     /// modes at 3-16 kHz): with its support damped in every direction
     /// (`support_damping_isotropic`) and an L-stable stepper (`ros34pw2`) its local errors
-    /// decay instead of accumulating, and the default absolute tolerance (that of the
-    /// rotor, 1e-6 m and `rtol * sqrt(2 g s) / 100` scaled by rtol) is what bounds the
-    /// implicit step in contact. The accuracy this costs is measured by `whirlmap accuracy`
+    /// decay instead of accumulating, and the default absolute tolerances (the rotor's:
+    /// `rtol * position_scale_m` on positions, `rtol * sqrt(2 g s) / 100` on velocities)
+    /// are what bound the implicit step in contact. The accuracy this costs is measured by `whirlmap accuracy`
     /// (README, "Speed against accuracy"). Default 1; allowed [1, 1e4]. Omitted from the
     /// canonical JSON while 1.
     #[serde(skip_serializing_if = "is_one")]
