@@ -1,10 +1,21 @@
 //! `whirlmap bench`: the performance figures the README reports, as counts and ratios.
 
 use std::hint::black_box;
+use std::ops::ControlFlow;
 use std::time::Instant;
-use whirlmap_core::model::{ix, DropSystem, Mode, Slip};
-use whirlmap_core::ode::OdeSystem;
-use whirlmap_core::{simulate, DropOptions, DropReport, Fidelity, Scene, StopReason};
+use whirlmap_core::model::{ix, DropSystem, Mode, ModelEvals, Slip, N};
+use whirlmap_core::ode::{Observer, OdeSystem, StepView};
+use whirlmap_core::{simulate_observed, DropOptions, DropReport, Fidelity, Scene, StopReason};
+
+/// Reads the force model's evaluation counters after every step (the last read is the drop's).
+#[derive(Default)]
+struct EvalCount(ModelEvals);
+impl Observer<DropSystem, N> for EvalCount {
+    fn on_step(&mut self, sys: &DropSystem, _s: &StepView<'_, N>) -> ControlFlow<()> {
+        self.0 = sys.model_evals();
+        ControlFlow::Continue(())
+    }
+}
 
 /// Options of `whirlmap bench`.
 #[derive(clap::Args)]
@@ -48,8 +59,15 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         Scene::paper().solver.rtol
     );
     println!(
-        "{:<36} {:>10} {:>11} {:>9} {:>8} {:>7} {:>12}",
-        "case", "wall ms", "RHS evals", "steps", "rejected", "events", "ns/RHS eval"
+        "{:<36} {:>10} {:>11} {:>9} {:>8} {:>7} {:>12} {:>16}",
+        "case",
+        "wall ms",
+        "RHS evals",
+        "steps",
+        "rejected",
+        "events",
+        "ns/RHS eval",
+        "model evals/step"
     );
     // Then the linearly implicit ROS34PW2 with the free-flight gap bound (README, "Speed
     // against accuracy") at two tolerances, and the isotropic support damper
@@ -163,13 +181,14 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         let mut walls = Vec::new();
         let mut last = None;
         for _ in 0..reps {
+            let mut count = EvalCount::default();
             let t = Instant::now();
-            let r = simulate(&scene, &opts)?;
+            let r = simulate_observed(&scene, &opts, &mut count)?;
             walls.push(t.elapsed().as_secs_f64() * 1e3);
-            last = Some(r);
+            last = Some((r, count.0));
         }
-        let r = last.expect("reps >= 1");
-        print_row(name, median(walls), &r);
+        let (r, evals) = last.expect("reps >= 1");
+        print_row(name, median(walls), &r, evals);
         if let Some(th) = &r.thermal {
             println!(
                 "    {} network steps for {:.3} s simulated",
@@ -211,22 +230,29 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// One row of the bench table.
-fn print_row(name: &str, wall_ms: f64, r: &DropReport) {
+/// One row of the bench table: the last column is the force model's evaluations per
+/// accepted step, computed + reused (the stepper's stages, the guards, the monitor; reused
+/// ones are served by `DropSystem`'s memo of the step end and midpoint).
+fn print_row(name: &str, wall_ms: f64, r: &DropReport, evals: ModelEvals) {
     let note = if r.stop_reason == StopReason::WhirlTurnsReached {
         " (whirl decided)"
     } else {
         ""
     };
     println!(
-        "{:<36} {:>10.2} {:>11} {:>9} {:>8} {:>7} {:>12.0}{note}",
+        "{:<36} {:>10.2} {:>11} {:>9} {:>8} {:>7} {:>12.0} {:>16}{note}",
         name,
         wall_ms,
         r.stats.rhs_evals,
         r.stats.steps,
         r.stats.rejected,
         r.stats.events,
-        wall_ms * 1e6 / r.stats.rhs_evals as f64
+        wall_ms * 1e6 / r.stats.rhs_evals as f64,
+        format!(
+            "{:.2} + {:.2}",
+            evals.computed as f64 / r.stats.steps as f64,
+            evals.reused as f64 / r.stats.steps as f64
+        )
     );
 }
 
@@ -246,11 +272,12 @@ fn long_thermal_run(name: &str, scene: &Scene, duration_s: f64) -> anyhow::Resul
         duration_s,
         ..Default::default()
     };
+    let mut count = EvalCount::default();
     let (t, c) = (Instant::now(), thread_cpu_s());
-    let r = simulate(scene, &opts)?;
+    let r = simulate_observed(scene, &opts, &mut count)?;
     let wall = t.elapsed().as_secs_f64();
     let cpu = c.zip(thread_cpu_s()).map(|(a, b)| b - a);
-    print_row(name, wall * 1e3, &r);
+    print_row(name, wall * 1e3, &r, count.0);
     let th = r.thermal.as_ref().expect("a thermal scene");
     let per_60 = |x: f64| x * 60.0 / r.end_time_s;
     println!(

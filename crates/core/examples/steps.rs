@@ -5,7 +5,7 @@
 use std::ops::ControlFlow;
 use whirlmap_core::ode::{Observer, StepView};
 use whirlmap_core::*;
-struct Rec(Vec<(f64, f64, bool, i32)>);
+struct Rec(Vec<(f64, f64, bool, i32)>, model::ModelEvals);
 impl Observer<model::DropSystem, { model::N }> for Rec {
     fn on_step(
         &mut self,
@@ -18,6 +18,7 @@ impl Observer<model::DropSystem, { model::N }> for Rec {
             model::Slip::Slipping(x) => x as i32,
         };
         self.0.push((s.dense.t0(), s.dense.t1(), m.contact, sl));
+        self.1 = sys.model_evals();
         ControlFlow::Continue(())
     }
 }
@@ -40,7 +41,7 @@ fn main() {
             _ => panic!("{k}"),
         }
     }
-    let mut rec = Rec(Vec::new());
+    let mut rec = Rec(Vec::new(), Default::default());
     let r = simulate_observed(
         &s,
         &DropOptions {
@@ -51,6 +52,7 @@ fn main() {
     )
     .unwrap();
     println!("{:?} stop: {:?}", r.stats, r.stop_reason);
+    println!("model evaluations: {:?}", rec.1);
     let mut w = [[0usize; 4]; 20];
     for &(t0, _t1, c, sl) in &rec.0 {
         let b = ((t0 / 0.05) as usize).min(19);

@@ -17,6 +17,7 @@ pub mod quasi_static;
 use crate::ode::{OdeSystem, StiffJacobian, MAX_GUARDS};
 use crate::scene::{FrictionLaw, Scene};
 pub use friction::Slip;
+use std::cell::RefCell;
 
 /// State layout: rotor (x, y, theta), race (x, y, theta), their rates, then three energy
 /// accumulators integrated with the state so the energy audit sees the same error control.
@@ -143,6 +144,61 @@ pub struct DropSystem {
     /// Palmgren load torque (eq. 31). Zero unless the scene's thermal model sets it; the
     /// macro-step coupling ([`crate::thermal`]) updates it between macro steps.
     pub thermal_load_n: f64,
+    /// The last two evaluations of [`DropSystem::forces`], see [`ForceCache`].
+    cache: RefCell<ForceCache>,
+}
+
+/// A two-entry memo of [`DropSystem::forces`], keyed on the exact bits of the state, the mode
+/// and the thermal load.
+///
+/// One accepted step evaluates the model at the same two states several times: the step end
+/// (the stepper's last stage or its end-point derivative, the driver's guards, the monitor's
+/// sample, the next step's Jacobian) and the step midpoint on the interpolant (the driver's
+/// guards, the monitor's sample). The model is a pure function of those keys, so a hit returns
+/// exactly what a fresh evaluation would: results are bit-identical with and without it.
+/// No crate offers a memo keyed on float bits with a fixed two-slot, allocation-free store.
+#[derive(Debug, Clone, Default)]
+struct ForceCache {
+    slots: [CacheEntry; 2],
+    /// The slot the next miss overwrites (the older one).
+    next: usize,
+    /// Evaluations not served by the memo.
+    misses: u64,
+    /// Evaluations served by the memo.
+    hits: u64,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct CacheEntry {
+    valid: bool,
+    y: [f64; N],
+    mode: Option<Mode>,
+    thermal_load_n: f64,
+    forces: Forces,
+}
+
+impl CacheEntry {
+    #[inline]
+    fn matches(&self, y: &[f64; N], mode: Mode, thermal_load_n: f64) -> bool {
+        self.valid
+            && self
+                .y
+                .iter()
+                .zip(y)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+            && self.mode == Some(mode)
+            && self.thermal_load_n.to_bits() == thermal_load_n.to_bits()
+    }
+}
+
+/// How often the model was evaluated in one drop (the figure benchmarks report besides the
+/// stepper's RHS count).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ModelEvals {
+    /// Evaluations of the force model actually computed.
+    pub computed: u64,
+    /// Requests answered from the two-entry memo (same state, mode and load bits).
+    pub reused: u64,
 }
 
 impl DropSystem {
@@ -201,6 +257,16 @@ impl DropSystem {
                 slip: Slip::Slipping(1.0),
             },
             thermal_load_n: 0.0,
+            cache: RefCell::new(ForceCache::default()),
+        }
+    }
+
+    /// How many force-model evaluations were computed and how many were reused so far.
+    pub fn model_evals(&self) -> ModelEvals {
+        let c = self.cache.borrow();
+        ModelEvals {
+            computed: c.misses,
+            reused: c.hits,
         }
     }
 
@@ -281,9 +347,27 @@ impl DropSystem {
             - a[5] * self.r_b
     }
 
-    /// All forces, powers and accelerations at `y` in the current mode.
+    /// All forces, powers and accelerations at `y` in the current mode (memoised: the last
+    /// two distinct requests are answered without recomputation, bit-identically).
     pub fn forces(&self, y: &[f64; N]) -> Forces {
-        self.forces_in(y, self.mode)
+        let (mode, load) = (self.mode, self.thermal_load_n);
+        let mut c = self.cache.borrow_mut();
+        for i in 0..2 {
+            if c.slots[i].matches(y, mode, load) {
+                c.hits += 1;
+                return c.slots[i].forces;
+            }
+        }
+        let i = c.next;
+        c.next = 1 - i;
+        c.misses += 1;
+        let e = &mut c.slots[i];
+        e.forces = self.forces_in(y, mode);
+        e.valid = true;
+        e.y = *y;
+        e.mode = Some(mode);
+        e.thermal_load_n = load;
+        e.forces
     }
 
     /// All forces, powers and accelerations at `y` in mode `mode`.

@@ -1,0 +1,136 @@
+//! The two-entry memo of `DropSystem::forces`: what it returns is exactly what a fresh
+//! evaluation gives (every field, bit for bit), a changed mode or thermal load is never served
+//! from it, and in a real drop it does serve the repeated step-end and midpoint evaluations.
+
+use std::ops::ControlFlow;
+use whirlmap_core::model::{ix, DropSystem, Forces, Mode, ModelEvals, Slip, N};
+use whirlmap_core::ode::{Observer, StepView};
+use whirlmap_core::{simulate_observed, DropOptions, Scene};
+
+/// Every field of `Forces`, as bits (`Forces` has no `PartialEq`; its `Debug` would hide a
+/// difference in a NaN payload).
+fn bits(f: &Forces) -> Vec<u64> {
+    let mut v = vec![
+        f.dist_m,
+        f.delta_m,
+        f.delta_dot_m_s,
+        f.v_rel_m_s,
+        f.normal_n,
+        f.normal_raw_n,
+        f.friction_n,
+        f.friction_required_n,
+        f.support_n,
+        f.support_raw_n,
+        f.drag_torque_n_m,
+        f.friction_power_w,
+        f.bearing_power_w,
+        f.damping_power_w,
+    ];
+    v.extend(f.n);
+    v.extend(f.t);
+    v.extend(f.acc);
+    v.into_iter().map(f64::to_bits).collect()
+}
+
+/// At every accepted step: the step end and midpoint, asked for again through the memo, equal
+/// a fresh `forces_in`; the counters at the end.
+struct Check {
+    steps: u64,
+    evals: ModelEvals,
+}
+impl Observer<DropSystem, N> for Check {
+    fn on_step(&mut self, sys: &DropSystem, s: &StepView<'_, N>) -> ControlFlow<()> {
+        let d = s.dense;
+        let tm = 0.5 * (d.t0() + d.t1());
+        for y in [d.y1(), d.eval(tm)] {
+            assert_eq!(bits(&sys.forces(&y)), bits(&sys.forces_in(&y, sys.mode)));
+        }
+        self.steps += 1;
+        self.evals = sys.model_evals();
+        ControlFlow::Continue(())
+    }
+}
+
+fn drop_checked(scene: &Scene, duration_s: f64) -> Check {
+    let mut c = Check {
+        steps: 0,
+        evals: ModelEvals::default(),
+    };
+    let opts = DropOptions {
+        duration_s,
+        ..Default::default()
+    };
+    simulate_observed(scene, &opts, &mut c).expect("drop runs");
+    c
+}
+
+#[test]
+fn memo_serves_repeats_with_the_exact_values_along_real_drops() {
+    // A pendulum drop (impacts, slipping, sticking) and a whirl drop, explicit and implicit.
+    let mut whirl = Scene::paper();
+    whirl.mu_dynamic = 0.4;
+    let mut ros = Scene::paper();
+    ros.solver.method = whirlmap_core::scene::Method::Ros34pw2;
+    for (scene, dur) in [(Scene::paper(), 0.2), (whirl, 0.03), (ros, 0.2)] {
+        let c = drop_checked(&scene, dur);
+        assert!(c.steps > 100);
+        // The step end is asked for by the driver's guards and the monitor after the stepper
+        // computed it; the midpoint by the guards, then the monitor (in contact): at least
+        // one reuse per step.
+        assert!(
+            c.evals.reused >= c.steps,
+            "{} reused for {} steps",
+            c.evals.reused,
+            c.steps
+        );
+        assert!(c.evals.computed > c.steps);
+    }
+}
+
+#[test]
+fn a_new_mode_or_thermal_load_is_never_served_from_the_memo() {
+    let scene = Scene::paper();
+    let mut sys = DropSystem::new(&scene);
+    let mut y = sys.initial_state(scene.spin_rad_s());
+    // The rotor pressed into the race, sliding, with a race that moves and spins.
+    y[ix::YR] = y[ix::YB] - scene.clearance_m - 2e-6;
+    y[ix::VXR] = 0.05;
+    y[ix::VYR] = -0.02;
+    y[ix::VXB] = 0.01;
+    y[ix::WB] = 100.0;
+    let slipping = Mode {
+        contact: true,
+        support: true,
+        slip: Slip::Slipping(1.0),
+    };
+    sys.mode = slipping;
+    let a = sys.forces(&y);
+    assert_eq!(sys.model_evals().computed, 1);
+    assert_eq!(bits(&sys.forces(&y)), bits(&a));
+    assert_eq!(sys.model_evals().reused, 1);
+    assert!(a.normal_n > 0.0 && a.friction_n != 0.0);
+
+    // Sticking at the same state: a different friction force, computed afresh.
+    sys.mode = Mode {
+        slip: Slip::Sticking,
+        ..slipping
+    };
+    let b = sys.forces(&y);
+    assert_eq!(sys.model_evals().computed, 2);
+    assert_eq!(bits(&b), bits(&sys.forces_in(&y, sys.mode)));
+    assert_ne!(bits(&b), bits(&a));
+
+    // The thermal load changes the drag torque (eq. 31): not served either.
+    sys.mode = slipping;
+    sys.thermal_load_n = 500.0;
+    let c = sys.forces(&y);
+    assert_eq!(sys.model_evals().computed, 3);
+    assert_eq!(bits(&c), bits(&sys.forces_in(&y, slipping)));
+    assert_ne!(c.drag_torque_n_m.to_bits(), a.drag_torque_n_m.to_bits());
+
+    // A state one ulp away is a different state.
+    let mut y2 = y;
+    y2[ix::XR] = f64::from_bits(y2[ix::XR].to_bits() + 1);
+    sys.forces(&y2);
+    assert_eq!(sys.model_evals().computed, 4);
+}
