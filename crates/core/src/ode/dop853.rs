@@ -20,7 +20,8 @@
 // against it digit by digit; f64 rounds them.
 #![allow(clippy::excessive_precision)]
 
-use super::dopri5::{initial_step, Dense, StepControl};
+use super::control::{StepCore, StepLaw};
+use super::dopri5::{Dense, StepControl};
 use super::{OdeSystem, Stats, Stepper};
 use crate::error::SolveError;
 
@@ -190,13 +191,18 @@ const D: [[f64; SX]; 4] = [
 /// The DOP853 stepper: stage storage, the FSAL derivative, the step size and work counters.
 #[derive(Debug, Clone)]
 pub struct Dop853<const N: usize> {
-    ctl: StepControl<N>,
-    /// Work counters, accumulated over every call.
-    pub stats: Stats,
-    h: f64,
+    core: StepCore<N>,
     k1: [f64; N],
-    dense: Dense<N>,
 }
+
+/// Hairer's dop853 defaults: safety 0.9, step ratio in [1/3, 6], no PI term.
+const LAW: StepLaw = StepLaw {
+    safe: 0.9,
+    expo: 1.0 / 8.0,
+    beta: 0.0,
+    fac_min: 0.333,
+    fac_max: 6.0,
+};
 
 /// `y + h * sum_j a[j] k[j]` over the first `s` stages.
 #[inline]
@@ -222,32 +228,24 @@ impl<const N: usize> Dop853<N> {
     /// A stepper with the given control settings and no step-size history.
     pub fn new(ctl: StepControl<N>) -> Self {
         Self {
-            ctl,
-            stats: Stats::default(),
-            h: 0.0,
+            core: StepCore::new(ctl, 8),
             k1: [0.0; N],
-            dense: Dense {
-                t0: 0.0,
-                h: 1.0,
-                t_end: 0.0,
-                terms: 8,
-                r: [[0.0; N]; 8],
-                y1: [0.0; N],
-            },
         }
     }
 
     /// One trial step: the stages 0-12 (12 = the derivative at the new state) and the error
     /// norm (Hairer's: the 5th-order estimate damped by the 3rd-order one).
+    #[allow(clippy::type_complexity)]
     fn attempt<S2: OdeSystem<N>>(
-        &mut self,
+        core: &mut StepCore<N>,
+        k1: &[f64; N],
         sys: &S2,
         t: f64,
         y: &[f64; N],
         h: f64,
-    ) -> ([f64; N], Box<[[f64; N]; SX]>, f64) {
+    ) -> (([f64; N], Box<[[f64; N]; SX]>), f64) {
         let mut k: Box<[[f64; N]; SX]> = Box::new([[0.0; N]; SX]);
-        k[0] = self.k1;
+        k[0] = *k1;
         for s in 1..S {
             let yt = stage_state(y, h, &A[s], &k, s);
             let mut ks = [0.0; N];
@@ -258,10 +256,10 @@ impl<const N: usize> Dop853<N> {
         let mut kn = [0.0; N];
         sys.rhs(t + h, &y_new, &mut kn);
         k[S] = kn;
-        self.stats.rhs_evals += S as u64;
+        core.stats.rhs_evals += S as u64;
         let (mut err5, mut err3) = (0.0, 0.0);
         for i in 0..N {
-            let sc = self.ctl.atol[i] + self.ctl.rtol * y[i].abs().max(y_new[i].abs());
+            let sc = core.ctl.atol[i] + core.ctl.rtol * y[i].abs().max(y_new[i].abs());
             let mut e5 = 0.0;
             let mut b8 = 0.0;
             for j in 0..S {
@@ -278,7 +276,7 @@ impl<const N: usize> Dop853<N> {
         } else {
             0.0
         };
-        (y_new, k, err)
+        ((y_new, k), err)
     }
 
     /// Builds the 7th-order dense output of an accepted step (3 more RHS evaluations).
@@ -297,7 +295,7 @@ impl<const N: usize> Dop853<N> {
             sys.rhs(t + C[s] * h, &yt, &mut ks);
             k[s] = ks;
         }
-        self.stats.rhs_evals += (SX - S - 1) as u64;
+        self.core.stats.rhs_evals += (SX - S - 1) as u64;
         let mut r = [[0.0; N]; 8];
         for i in 0..N {
             let dy = y_new[i] - y[i];
@@ -313,7 +311,7 @@ impl<const N: usize> Dop853<N> {
                 r[4 + m][i] = h * acc;
             }
         }
-        self.dense = Dense {
+        self.core.dense = Dense {
             t0: t,
             h,
             t_end: t + h,
@@ -322,19 +320,14 @@ impl<const N: usize> Dop853<N> {
             y1: *y_new,
         };
         self.k1 = k[S];
-        self.stats.steps += 1;
+        self.core.stats.steps += 1;
     }
 }
 
 impl<const N: usize> Stepper<N> for Dop853<N> {
     fn restart<S2: OdeSystem<N>>(&mut self, sys: &S2, t: f64, y: &[f64; N]) {
         sys.rhs(t, y, &mut self.k1);
-        self.stats.rhs_evals += 1;
-        if let Some(hf) = self.ctl.fixed_step {
-            self.h = hf;
-        } else if self.h == 0.0 {
-            self.h = initial_step(&self.ctl, y, &self.k1, sys.max_step());
-        }
+        self.core.restart(sys, y, &self.k1);
     }
 
     fn step<S2: OdeSystem<N>>(
@@ -344,68 +337,28 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError> {
-        // Hairer's dop853 defaults: safety 0.9, step ratio in [1/3, 6], no PI term.
-        const SAFE: f64 = 0.9;
-        const EXPO: f64 = 1.0 / 8.0;
-        const FAC_MIN: f64 = 0.333;
-        const FAC_MAX: f64 = 6.0;
-        let mut rejected_last = false;
-        loop {
-            if self.stats.steps + self.stats.rejected >= self.ctl.max_attempts {
-                return Err(SolveError::StepBudget {
-                    t_s: t,
-                    attempts: self.stats.steps + self.stats.rejected,
-                });
-            }
-            let h = self.h.min(h_cap);
-            if h < self.ctl.h_min && h < h_cap {
-                return Err(SolveError::StepSizeUnderflow { t_s: t, h_s: h });
-            }
-            let (y_new, mut k, err) = self.attempt(sys, t, y, h);
-            let fixed = self.ctl.fixed_step.is_some();
-            if !err.is_finite() && (fixed || h <= self.ctl.h_min) {
-                return Err(SolveError::NonFiniteState { t_s: t });
-            }
-            if fixed || (err.is_finite() && err <= 1.0) {
-                self.accept(sys, t, y, h, &y_new, &mut k);
-                if !fixed {
-                    let fac =
-                        (err.max(1e-10).powf(EXPO) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                    let mut h_new = h / fac;
-                    if rejected_last {
-                        h_new = h_new.min(h);
-                    }
-                    self.h = h_new;
-                }
-                return Ok(&self.dense);
-            }
-            self.stats.rejected += 1;
-            rejected_last = true;
-            self.h = if err.is_finite() {
-                h / (err.powf(EXPO) / SAFE).min(1.0 / FAC_MIN)
-            } else {
-                h * FAC_MIN
-            };
-        }
+        let k1 = &self.k1;
+        let ((y_new, mut k), h) = self.core.control(&LAW, t, h_cap, |core, h| {
+            Self::attempt(core, k1, sys, t, y, h)
+        })?;
+        self.accept(sys, t, y, h, &y_new, &mut k);
+        Ok(&self.core.dense)
     }
 
     fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
-        self.dense.t_end = t_cut;
-        &self.dense
+        self.core.cut_last_step(t_cut)
     }
     fn last_dense(&self) -> &Dense<N> {
-        &self.dense
+        &self.core.dense
     }
     fn cap_next_step(&mut self, h_s: f64) {
-        if self.ctl.fixed_step.is_none() {
-            self.h = self.h.min(h_s);
-        }
+        self.core.cap_next_step(h_s)
     }
     fn stats(&self) -> Stats {
-        self.stats
+        self.core.stats
     }
     fn count_event(&mut self) {
-        self.stats.events += 1;
+        self.core.stats.events += 1;
     }
 }
 

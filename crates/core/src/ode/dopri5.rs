@@ -4,6 +4,7 @@
 //! J. Comp. Appl. Math. 6 (1980); dense output and controller as in E. Hairer, S. P. Nørsett,
 //! G. Wanner, "Solving Ordinary Differential Equations I", 2nd ed., Sec. II.4-II.6 (DOPRI5).
 
+use super::control::{StepCore, StepLaw};
 use super::{OdeSystem, Stats, Stepper};
 use crate::error::SolveError;
 
@@ -145,33 +146,26 @@ pub(super) fn initial_step<const N: usize>(
 /// The stepper: stage storage, the FSAL derivative, controller memory and work counters.
 #[derive(Debug, Clone)]
 pub struct Dopri5<const N: usize> {
-    ctl: StepControl<N>,
-    /// Work counters, accumulated over every call.
-    pub stats: Stats,
-    h: f64,
-    err_old: f64,
+    core: StepCore<N>,
     k1: [f64; N],
-    dense: Dense<N>,
     dy_last: [f64; N],
 }
+
+/// Hairer's PI controller for DOPRI5: safety 0.9, beta 0.04, step ratio in [1/5, 10].
+const LAW: StepLaw = StepLaw {
+    safe: 0.9,
+    expo: 0.2 - 0.04 * 0.75,
+    beta: 0.04,
+    fac_min: 0.2,
+    fac_max: 10.0,
+};
 
 impl<const N: usize> Dopri5<N> {
     /// A stepper with the given control settings and no step-size history.
     pub fn new(ctl: StepControl<N>) -> Self {
         Self {
-            ctl,
-            stats: Stats::default(),
-            h: 0.0,
-            err_old: 1e-4,
+            core: StepCore::new(ctl, 5),
             k1: [0.0; N],
-            dense: Dense {
-                t0: 0.0,
-                h: 1.0,
-                t_end: 0.0,
-                terms: 5,
-                r: [[0.0; N]; 8],
-                y1: [0.0; N],
-            },
             dy_last: [0.0; N],
         }
     }
@@ -180,28 +174,22 @@ impl<const N: usize> Dopri5<N> {
     /// first call, picks an initial step (Hairer's `hinit`).
     pub fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
         sys.rhs(t, y, &mut self.k1);
-        self.stats.rhs_evals += 1;
-        if let Some(hf) = self.ctl.fixed_step {
-            self.h = hf;
-            return;
-        }
-        if self.h == 0.0 {
-            self.h = initial_step(&self.ctl, y, &self.k1, sys.max_step());
-        }
+        self.core.restart(sys, y, &self.k1);
     }
 
-    /// Caps the next step at `h_s` (the controller grows it again from there). Used after a
-    /// mode switch: a contact law like `delta^(10/9)` is not smooth where the new mode starts,
-    /// so the embedded error estimate is least reliable on the first step after it.
+    /// Caps the next step at `h_s` (see [`StepCore::cap_next_step`]).
     pub fn cap_next_step(&mut self, h_s: f64) {
-        if self.ctl.fixed_step.is_none() {
-            self.h = self.h.min(h_s);
-        }
+        self.core.cap_next_step(h_s)
     }
 
     /// The interpolant of the last accepted step.
     pub fn last_dense(&self) -> &Dense<N> {
-        &self.dense
+        &self.core.dense
+    }
+
+    /// Work counters, accumulated over every call.
+    pub fn stats(&self) -> Stats {
+        self.core.stats
     }
     /// The derivative at the end of the last accepted step.
     pub fn last_dy(&self) -> &[f64; N] {
@@ -234,7 +222,7 @@ impl<const N: usize> Dopri5<N> {
                     + D6 * k[3][i]
                     + D7 * k7[i]);
         }
-        self.dense = Dense {
+        self.core.dense = Dense {
             t0: t,
             h,
             t_end: t + h,
@@ -244,15 +232,14 @@ impl<const N: usize> Dopri5<N> {
         };
         self.k1 = *k7;
         self.dy_last = *k7;
-        self.stats.steps += 1;
+        self.core.stats.steps += 1;
     }
 
     /// Cuts the last accepted step at `t_cut` (an event time inside it) and returns it. The
     /// state there comes from the interpolant, on the new side of the located crossing; the
     /// next [`Dopri5::restart`] re-evaluates the derivative there.
     pub fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
-        self.dense.t_end = t_cut;
-        &self.dense
+        self.core.cut_last_step(t_cut)
     }
 
     /// Takes one accepted step from `(t, y)` of at most `h_cap`, retrying rejected attempts.
@@ -263,106 +250,64 @@ impl<const N: usize> Dopri5<N> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError> {
-        const SAFE: f64 = 0.9;
-        const BETA: f64 = 0.04;
-        const EXPO1: f64 = 0.2 - BETA * 0.75;
-        const FAC_MIN: f64 = 0.2; // largest shrink: h / 5
-        const FAC_MAX: f64 = 10.0; // largest growth
-        let mut rejected_last = false;
-        loop {
-            if self.stats.steps + self.stats.rejected >= self.ctl.max_attempts {
-                return Err(SolveError::StepBudget {
-                    t_s: t,
-                    attempts: self.stats.steps + self.stats.rejected,
-                });
-            }
-            let h = self.h.min(h_cap);
-            if h < self.ctl.h_min && h < h_cap {
-                return Err(SolveError::StepSizeUnderflow { t_s: t, h_s: h });
-            }
-            let (y_new, k7, k, err) = self.attempt(sys, t, y, h);
-            let fixed = self.ctl.fixed_step.is_some();
-            if !err.is_finite() && (fixed || h <= self.ctl.h_min) {
-                return Err(SolveError::NonFiniteState { t_s: t });
-            }
-            if fixed || (err.is_finite() && err <= 1.0) {
-                self.accept(t, y, h, &y_new, &k7, &k);
-                if !fixed {
-                    let fac11 = err.max(1e-10).powf(EXPO1);
-                    let fac = (fac11 / self.err_old.powf(BETA) / SAFE)
-                        .clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                    let mut h_new = h / fac;
-                    if rejected_last {
-                        h_new = h_new.min(h);
-                    }
-                    self.err_old = err.max(1e-4);
-                    // Keep a capped step's growth honest: grow from the step actually taken.
-                    self.h = h_new;
-                }
-                return Ok(&self.dense);
-            }
-            self.stats.rejected += 1;
-            rejected_last = true;
-            self.h = if err.is_finite() {
-                h / (err.powf(EXPO1) / SAFE).min(1.0 / FAC_MIN)
-            } else {
-                h * FAC_MIN
-            };
-        }
-    }
-
-    /// One trial step: the 5th-order solution, the end derivative, stages 3-6, and the error
-    /// norm (RMS of the embedded error over `atol + rtol * max(|y0|, |y1|)`).
-    #[allow(clippy::type_complexity)]
-    fn attempt<S: OdeSystem<N>>(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &[f64; N],
-        h: f64,
-    ) -> ([f64; N], [f64; N], [[f64; N]; 4], f64) {
         let k1 = &self.k1;
-        let mut yt = [0.0; N];
-        let (mut k2, mut k3, mut k4, mut k5, mut k6, mut k7) =
-            ([0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N]);
-        for i in 0..N {
-            yt[i] = y[i] + h * A21 * k1[i];
-        }
-        sys.rhs(t + C2 * h, &yt, &mut k2);
-        for i in 0..N {
-            yt[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i]);
-        }
-        sys.rhs(t + C3 * h, &yt, &mut k3);
-        for i in 0..N {
-            yt[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
-        }
-        sys.rhs(t + C4 * h, &yt, &mut k4);
-        for i in 0..N {
-            yt[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
-        }
-        sys.rhs(t + C5 * h, &yt, &mut k5);
-        for i in 0..N {
-            yt[i] =
-                y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
-        }
-        sys.rhs(t + h, &yt, &mut k6);
-        let mut y_new = [0.0; N];
-        for i in 0..N {
-            y_new[i] =
-                y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
-        }
-        sys.rhs(t + h, &y_new, &mut k7);
-        self.stats.rhs_evals += 6;
-        let mut acc = 0.0;
-        for i in 0..N {
-            let e =
-                h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
-            let sc = self.ctl.atol[i] + self.ctl.rtol * y[i].abs().max(y_new[i].abs());
-            acc += (e / sc) * (e / sc);
-        }
-        let err = (acc / N as f64).sqrt();
-        (y_new, k7, [k3, k4, k5, k6], err)
+        let ((y_new, k7, k), h) = self
+            .core
+            .control(&LAW, t, h_cap, |core, h| attempt(core, k1, sys, t, y, h))?;
+        self.accept(t, y, h, &y_new, &k7, &k);
+        Ok(&self.core.dense)
     }
+}
+
+/// One trial step from `(t, y)` with first stage `k1`: the 5th-order solution, the end
+/// derivative, stages 3-6, and the error norm (RMS of the embedded error over
+/// `atol + rtol * max(|y0|, |y1|)`).
+#[allow(clippy::type_complexity)]
+fn attempt<S: OdeSystem<N>, const N: usize>(
+    core: &mut StepCore<N>,
+    k1: &[f64; N],
+    sys: &S,
+    t: f64,
+    y: &[f64; N],
+    h: f64,
+) -> (([f64; N], [f64; N], [[f64; N]; 4]), f64) {
+    let mut yt = [0.0; N];
+    let (mut k2, mut k3, mut k4, mut k5, mut k6, mut k7) =
+        ([0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+    for i in 0..N {
+        yt[i] = y[i] + h * A21 * k1[i];
+    }
+    sys.rhs(t + C2 * h, &yt, &mut k2);
+    for i in 0..N {
+        yt[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i]);
+    }
+    sys.rhs(t + C3 * h, &yt, &mut k3);
+    for i in 0..N {
+        yt[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
+    }
+    sys.rhs(t + C4 * h, &yt, &mut k4);
+    for i in 0..N {
+        yt[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
+    }
+    sys.rhs(t + C5 * h, &yt, &mut k5);
+    for i in 0..N {
+        yt[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
+    }
+    sys.rhs(t + h, &yt, &mut k6);
+    let mut y_new = [0.0; N];
+    for i in 0..N {
+        y_new[i] = y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
+    }
+    sys.rhs(t + h, &y_new, &mut k7);
+    core.stats.rhs_evals += 6;
+    let mut acc = 0.0;
+    for i in 0..N {
+        let e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
+        let sc = core.ctl.atol[i] + core.ctl.rtol * y[i].abs().max(y_new[i].abs());
+        acc += (e / sc) * (e / sc);
+    }
+    let err = (acc / N as f64).sqrt();
+    ((y_new, k7, [k3, k4, k5, k6]), err)
 }
 
 impl<const N: usize> Stepper<N> for Dopri5<N> {
@@ -382,16 +327,16 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         Dopri5::cut_last_step(self, t_cut)
     }
     fn last_dense(&self) -> &Dense<N> {
-        &self.dense
+        &self.core.dense
     }
     fn cap_next_step(&mut self, h_s: f64) {
         Dopri5::cap_next_step(self, h_s)
     }
     fn stats(&self) -> Stats {
-        self.stats
+        self.core.stats
     }
     fn count_event(&mut self) {
-        self.stats.events += 1;
+        self.core.stats.events += 1;
     }
 }
 

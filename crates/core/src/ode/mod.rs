@@ -7,6 +7,7 @@
 //! crosses to zero or below; it then returns *why* it stopped as a [`Stop`] and the caller
 //! switches mode and calls it again (the step restarts cleanly, without the FSAL stage).
 
+mod control;
 mod dop853;
 mod dopri5;
 mod events;

@@ -16,7 +16,7 @@
 //! method); the derivative at the end is evaluated once and reused as the next step's first
 //! stage.
 
-use super::dopri5::initial_step;
+use super::control::{StepCore, StepLaw};
 use super::{Dense, OdeSystem, Stats, StepControl, Stepper, StiffJacobian, MAX_STIFF};
 use crate::error::SolveError;
 
@@ -177,50 +177,46 @@ impl Lu {
 /// controller memory and work counters.
 #[derive(Debug, Clone)]
 pub struct Ros34pw2<const N: usize> {
-    ctl: StepControl<N>,
-    /// Work counters, accumulated over every call.
-    pub stats: Stats,
-    h: f64,
+    core: StepCore<N>,
     f0: [f64; N],
-    dense: Dense<N>,
     lu: Lu,
 }
+
+/// The error estimate is O(h^3): exponent 1/3, safety 0.9, step ratio in [1/5, 6].
+const LAW: StepLaw = StepLaw {
+    safe: 0.9,
+    expo: 1.0 / 3.0,
+    beta: 0.0,
+    fac_min: 0.2,
+    fac_max: 6.0,
+};
 
 impl<const N: usize> Ros34pw2<N> {
     /// A stepper with the given control settings and no step-size history.
     pub fn new(ctl: StepControl<N>) -> Self {
         Self {
-            ctl,
-            stats: Stats::default(),
-            h: 0.0,
+            core: StepCore::new(ctl, 5),
             f0: [0.0; N],
-            dense: Dense {
-                t0: 0.0,
-                h: 1.0,
-                t_end: 0.0,
-                terms: 5,
-                r: [[0.0; N]; 8],
-                y1: [0.0; N],
-            },
             lu: Lu::identity(),
         }
     }
 
-    /// One trial step of size `h` with `self.lu` factored for it: the new state, the error
-    /// norm.
+    /// One trial step of size `h` from `(t, y)` with derivative `f0` there and `lu` factored
+    /// for it: the new state, the error norm.
     fn attempt<S: OdeSystem<N>>(
-        &mut self,
+        core: &mut StepCore<N>,
+        lu: &Lu,
+        f0: &[f64; N],
         sys: &S,
         t: f64,
         y: &[f64; N],
         h: f64,
     ) -> ([f64; N], f64) {
-        let lu = &self.lu;
         let mut k = [[0.0; N]; 4];
         // Stage 1.
         let mut r = [0.0; N];
         for i in 0..N {
-            r[i] = h * self.f0[i];
+            r[i] = h * f0[i];
         }
         lu.solve(&mut r);
         k[0] = r;
@@ -263,7 +259,7 @@ impl<const N: usize> Ros34pw2<N> {
         lu.add_jv(h, &u, &mut r);
         lu.solve(&mut r);
         k[3] = r;
-        self.stats.rhs_evals += 3;
+        core.stats.rhs_evals += 3;
         let mut y1 = [0.0; N];
         let mut e = [0.0; N];
         for i in 0..N {
@@ -280,7 +276,7 @@ impl<const N: usize> Ros34pw2<N> {
         lu.solve(&mut e);
         let mut err = 0.0;
         for i in 0..N {
-            let sc = self.ctl.atol[i] + self.ctl.rtol * y[i].abs().max(y1[i].abs());
+            let sc = core.ctl.atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());
             err += (e[i] / sc) * (e[i] / sc);
         }
         (y1, (err / N as f64).sqrt())
@@ -290,14 +286,7 @@ impl<const N: usize> Ros34pw2<N> {
 impl<const N: usize> Stepper<N> for Ros34pw2<N> {
     fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
         sys.rhs(t, y, &mut self.f0);
-        self.stats.rhs_evals += 1;
-        if let Some(hf) = self.ctl.fixed_step {
-            self.h = hf;
-            return;
-        }
-        if self.h == 0.0 {
-            self.h = initial_step(&self.ctl, y, &self.f0, sys.max_step());
-        }
+        self.core.restart(sys, y, &self.f0);
     }
 
     fn step<S: OdeSystem<N>>(
@@ -307,97 +296,57 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError> {
-        const SAFE: f64 = 0.9;
-        const FAC_MIN: f64 = 0.2;
-        const FAC_MAX: f64 = 6.0;
-        // The error estimate is O(h^3): the controller's exponent.
-        const EXPO: f64 = 1.0 / 3.0;
         self.lu.j = sys
             .stiff_jacobian(t, y)
             .unwrap_or_else(|| StiffJacobian::over(&[]));
-        let mut rejected_last = false;
-        loop {
-            if self.stats.steps + self.stats.rejected >= self.ctl.max_attempts {
-                return Err(SolveError::StepBudget {
-                    t_s: t,
-                    attempts: self.stats.steps + self.stats.rejected,
-                });
-            }
-            let h = self.h.min(h_cap);
-            if h < self.ctl.h_min && h < h_cap {
-                return Err(SolveError::StepSizeUnderflow { t_s: t, h_s: h });
-            }
-            let fixed = self.ctl.fixed_step.is_some();
-            let (y1, err) = if self.lu.factor(h * GAMMA) {
-                self.attempt(sys, t, y, h)
+        let (lu, f0) = (&mut self.lu, &self.f0);
+        let (y1, h) = self.core.control(&LAW, t, h_cap, |core, h| {
+            if lu.factor(h * GAMMA) {
+                Self::attempt(core, lu, f0, sys, t, y, h)
             } else {
                 ([f64::NAN; N], f64::NAN)
-            };
-            if !err.is_finite() && (fixed || h <= self.ctl.h_min) {
-                return Err(SolveError::NonFiniteState { t_s: t });
             }
-            if fixed || (err.is_finite() && err <= 1.0) {
-                let mut f1 = [0.0; N];
-                sys.rhs(t + h, &y1, &mut f1);
-                self.stats.rhs_evals += 1;
-                // Cubic Hermite in DOPRI5's nested form with the 4th coefficient zero.
-                let mut r = [[0.0; N]; 8];
-                for i in 0..N {
-                    let ydiff = y1[i] - y[i];
-                    let bspl = h * self.f0[i] - ydiff;
-                    r[0][i] = y[i];
-                    r[1][i] = ydiff;
-                    r[2][i] = bspl;
-                    r[3][i] = ydiff - h * f1[i] - bspl;
-                }
-                self.dense = Dense {
-                    t0: t,
-                    h,
-                    t_end: t + h,
-                    terms: 5,
-                    r,
-                    y1,
-                };
-                self.f0 = f1;
-                self.stats.steps += 1;
-                if !fixed {
-                    let fac =
-                        (err.max(1e-10).powf(EXPO) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                    let mut h_new = h / fac;
-                    if rejected_last {
-                        h_new = h_new.min(h);
-                    }
-                    self.h = h_new;
-                }
-                return Ok(&self.dense);
-            }
-            self.stats.rejected += 1;
-            rejected_last = true;
-            self.h = if err.is_finite() {
-                h / (err.powf(EXPO) / SAFE).min(1.0 / FAC_MIN)
-            } else {
-                h * FAC_MIN
-            };
+        })?;
+        let mut f1 = [0.0; N];
+        sys.rhs(t + h, &y1, &mut f1);
+        self.core.stats.rhs_evals += 1;
+        // Cubic Hermite in DOPRI5's nested form with the 4th coefficient zero.
+        let mut r = [[0.0; N]; 8];
+        for i in 0..N {
+            let ydiff = y1[i] - y[i];
+            let bspl = h * self.f0[i] - ydiff;
+            r[0][i] = y[i];
+            r[1][i] = ydiff;
+            r[2][i] = bspl;
+            r[3][i] = ydiff - h * f1[i] - bspl;
         }
+        self.core.dense = Dense {
+            t0: t,
+            h,
+            t_end: t + h,
+            terms: 5,
+            r,
+            y1,
+        };
+        self.f0 = f1;
+        self.core.stats.steps += 1;
+        Ok(&self.core.dense)
     }
 
     fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
-        self.dense.t_end = t_cut;
-        &self.dense
+        self.core.cut_last_step(t_cut)
     }
     fn last_dense(&self) -> &Dense<N> {
-        &self.dense
+        &self.core.dense
     }
     fn cap_next_step(&mut self, h_s: f64) {
-        if self.ctl.fixed_step.is_none() {
-            self.h = self.h.min(h_s);
-        }
+        self.core.cap_next_step(h_s)
     }
     fn stats(&self) -> Stats {
-        self.stats
+        self.core.stats
     }
     fn count_event(&mut self) {
-        self.stats.events += 1;
+        self.core.stats.events += 1;
     }
 }
 
@@ -493,7 +442,7 @@ mod tests {
                 &mut NoObserver,
             )
             .unwrap();
-            (y, st.stats)
+            (y, st.stats())
         };
         let (y_imp, s_imp) = run(true);
         let (y_exp, s_exp) = run(false);

@@ -109,10 +109,10 @@ pub fn simulate_fully_coupled(
         )? {
             Stop::EndTime | Stop::Observer => break,
             Stop::Event { index } => {
-                if stepper.stats.events >= scene.solver.max_events {
+                if stepper.stats().events >= scene.solver.max_events {
                     return Err(SolveError::EventBudget {
                         t_s: t,
-                        events: stepper.stats.events,
+                        events: stepper.stats().events,
                     });
                 }
                 let (s, yd) = c.loaded(&y);
@@ -132,6 +132,6 @@ pub fn simulate_fully_coupled(
         load_n: model.expansion.load_n(&dt),
         h_s_j: y[ix::E_FRIC],
         bearing_j: y[ix::E_DRAG],
-        stats: stepper.stats,
+        stats: stepper.stats(),
     })
 }

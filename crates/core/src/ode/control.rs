@@ -1,0 +1,224 @@
+//! What the three adaptive steppers share: the step-size history, the work counters, the last
+//! interpolant, and the accept/reject loop with its step-size law. Each stepper supplies only
+//! its trial step (stages, error norm) and builds its interpolant.
+
+use super::dopri5::{initial_step, Dense, StepControl};
+use super::{OdeSystem, Stats};
+use crate::error::SolveError;
+
+/// A step-size law (Hairer-Wanner I, II.4 and IV.8): after an attempt with error norm `err`,
+/// the next step is `h / clamp(err^expo / err_old^beta / safe, 1/fac_max, 1/fac_min)`, where
+/// `err_old` is the previous accepted step's norm (a PI controller when `beta > 0`); after a
+/// rejection the step only shrinks, by at most `fac_min`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct StepLaw {
+    /// Safety factor.
+    pub safe: f64,
+    /// Exponent on the error norm (about 1 / (order of the estimate + 1), minus the PI part).
+    pub expo: f64,
+    /// Exponent on the previous accepted norm (0: no PI term).
+    pub beta: f64,
+    /// Largest shrink of one attempt (h_new >= fac_min h).
+    pub fac_min: f64,
+    /// Largest growth of one accepted step (h_new <= fac_max h).
+    pub fac_max: f64,
+}
+
+/// The state every adaptive stepper keeps besides its stages.
+#[derive(Debug, Clone)]
+pub(super) struct StepCore<const N: usize> {
+    /// Tolerances, limits and the optional fixed step.
+    pub ctl: StepControl<N>,
+    /// Work counters, accumulated over every call.
+    pub stats: Stats,
+    /// The next step to try (s); 0 before the first restart.
+    pub h: f64,
+    /// The previous accepted error norm (PI memory; floored at 1e-4).
+    pub err_old: f64,
+    /// The interpolant of the last accepted step.
+    pub dense: Dense<N>,
+}
+
+impl<const N: usize> StepCore<N> {
+    /// A core with no step-size history whose interpolant uses `terms` coefficient vectors.
+    pub fn new(ctl: StepControl<N>, terms: usize) -> Self {
+        Self {
+            ctl,
+            stats: Stats::default(),
+            h: 0.0,
+            err_old: 1e-4,
+            dense: Dense {
+                t0: 0.0,
+                h: 1.0,
+                t_end: 0.0,
+                terms,
+                r: [[0.0; N]; 8],
+                y1: [0.0; N],
+            },
+        }
+    }
+
+    /// After a restart's derivative `dy` at `y`: the fixed step, or on the first call an
+    /// initial step (Hairer's `hinit`, capped by the system's largest step).
+    pub fn restart<S: OdeSystem<N>>(&mut self, sys: &S, y: &[f64; N], dy: &[f64; N]) {
+        self.stats.rhs_evals += 1;
+        if let Some(hf) = self.ctl.fixed_step {
+            self.h = hf;
+        } else if self.h == 0.0 {
+            self.h = initial_step(&self.ctl, y, dy, sys.max_step());
+        }
+    }
+
+    /// Caps the next step at `h_s` (the controller grows it again from there). Used after a
+    /// mode switch: a contact law like `delta^(10/9)` is not smooth where the new mode starts,
+    /// so the embedded error estimate is least reliable on the first step after it.
+    pub fn cap_next_step(&mut self, h_s: f64) {
+        if self.ctl.fixed_step.is_none() {
+            self.h = self.h.min(h_s);
+        }
+    }
+
+    /// Cuts the last accepted step at `t_cut` and returns its interpolant.
+    pub fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
+        self.dense.t_end = t_cut;
+        &self.dense
+    }
+
+    /// Tries steps of at most `h_cap` from time `t` until one is accepted, and returns its
+    /// trial and size; the next step size is then already set. `attempt(core, h)` returns a
+    /// trial and its error norm (NaN when the step could not be formed). Errors: the attempt
+    /// budget, a step below `h_min`, and a non-finite norm at the smallest or a fixed step.
+    pub fn control<T>(
+        &mut self,
+        law: &StepLaw,
+        t: f64,
+        h_cap: f64,
+        mut attempt: impl FnMut(&mut Self, f64) -> (T, f64),
+    ) -> Result<(T, f64), SolveError> {
+        let mut rejected_last = false;
+        loop {
+            if self.stats.steps + self.stats.rejected >= self.ctl.max_attempts {
+                return Err(SolveError::StepBudget {
+                    t_s: t,
+                    attempts: self.stats.steps + self.stats.rejected,
+                });
+            }
+            let h = self.h.min(h_cap);
+            if h < self.ctl.h_min && h < h_cap {
+                return Err(SolveError::StepSizeUnderflow { t_s: t, h_s: h });
+            }
+            let (trial, err) = attempt(self, h);
+            let fixed = self.ctl.fixed_step.is_some();
+            if !err.is_finite() && (fixed || h <= self.ctl.h_min) {
+                return Err(SolveError::NonFiniteState { t_s: t });
+            }
+            if fixed || (err.is_finite() && err <= 1.0) {
+                if !fixed {
+                    // err_old^0 = 1 exactly, so without a PI term this is the plain law.
+                    let fac =
+                        (err.max(1e-10).powf(law.expo) / self.err_old.powf(law.beta) / law.safe)
+                            .clamp(1.0 / law.fac_max, 1.0 / law.fac_min);
+                    let mut h_new = h / fac;
+                    if rejected_last {
+                        h_new = h_new.min(h);
+                    }
+                    self.err_old = err.max(1e-4);
+                    self.h = h_new;
+                }
+                return Ok((trial, h));
+            }
+            self.stats.rejected += 1;
+            rejected_last = true;
+            self.h = if err.is_finite() {
+                h / (err.powf(law.expo) / law.safe).min(1.0 / law.fac_min)
+            } else {
+                h * law.fac_min
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LAW: StepLaw = StepLaw {
+        safe: 0.9,
+        expo: 0.25,
+        beta: 0.0,
+        fac_min: 0.2,
+        fac_max: 6.0,
+    };
+
+    fn core(max_attempts: u64, fixed_step: Option<f64>) -> StepCore<1> {
+        let mut c = StepCore::new(
+            StepControl {
+                rtol: 1e-6,
+                atol: [1e-9],
+                h_min: 1e-12,
+                max_attempts,
+                fixed_step,
+            },
+            5,
+        );
+        c.h = 1e-3;
+        c
+    }
+
+    #[test]
+    fn accepted_steps_follow_the_law_and_rejections_only_shrink() {
+        let mut c = core(100, None);
+        // err = 1/16: growth 16^(1/4) * 0.9 = 1.8.
+        let (_, h) = c.control(&LAW, 0.0, 1.0, |_, _| ((), 1.0 / 16.0)).unwrap();
+        assert_eq!(h, 1e-3);
+        assert!((c.h / 1e-3 - 1.8).abs() < 1e-12);
+        // Tiny errors are capped at fac_max.
+        let h0 = c.h;
+        c.control(&LAW, 0.0, 1.0, |_, _| ((), 0.0)).unwrap();
+        assert!((c.h / h0 - 6.0).abs() < 1e-12);
+        // Two rejections (err 16: shrink to 0.45 h each), then an acceptance with a small
+        // error may not grow beyond the step just taken.
+        let mut errs = [16.0, 16.0, 1e-6].into_iter();
+        let h0 = c.h;
+        let (_, h) = c
+            .control(&LAW, 0.0, 1.0, |_, _| ((), errs.next().unwrap()))
+            .unwrap();
+        assert!((h / h0 - 0.45 * 0.45).abs() < 1e-12);
+        assert_eq!(c.h, h);
+        assert_eq!(c.stats.rejected, 2);
+        // A huge error shrinks by at most fac_min; a non-finite one by exactly fac_min.
+        let mut errs = [1e30, f64::NAN, 0.5].into_iter();
+        let h0 = c.h;
+        let (_, h) = c
+            .control(&LAW, 0.0, 1.0, |_, _| ((), errs.next().unwrap()))
+            .unwrap();
+        assert!((h / h0 - 0.04).abs() < 1e-12);
+        // The cap bounds the attempt without changing the history's growth rule.
+        let (_, h) = c.control(&LAW, 0.0, 1e-9, |_, _| ((), 0.5)).unwrap();
+        assert_eq!(h, 1e-9);
+    }
+
+    #[test]
+    fn budget_underflow_and_non_finite_errors() {
+        let mut c = core(3, None);
+        let e = c.control(&LAW, 0.5, 1.0, |_, _| ((), 2.0)).unwrap_err();
+        assert!(
+            matches!(e, SolveError::StepBudget { attempts: 3, .. }),
+            "{e:?}"
+        );
+
+        let mut c = core(1000, None);
+        let e = c.control(&LAW, 0.5, 1.0, |_, _| ((), 1e300)).unwrap_err();
+        assert!(matches!(e, SolveError::StepSizeUnderflow { .. }), "{e:?}");
+
+        // A fixed step is accepted whatever the error, unless it is not finite.
+        let mut c = core(1000, Some(1e-4));
+        c.h = 1e-4;
+        let (_, h) = c.control(&LAW, 0.0, 1.0, |_, _| ((), 1e9)).unwrap();
+        assert_eq!((h, c.h), (1e-4, 1e-4));
+        let e = c
+            .control(&LAW, 0.0, 1.0, |_, _| ((), f64::NAN))
+            .unwrap_err();
+        assert!(matches!(e, SolveError::NonFiniteState { .. }), "{e:?}");
+    }
+}
