@@ -263,7 +263,8 @@ fn is_zero2(v: &[f64; 2]) -> bool {
 
 impl Scene {
     /// Fields left out of the serialised scene while at their default (so adding them did
-    /// not change existing scene hashes); settable by name all the same.
+    /// not change existing scene hashes), dotted for nested fields; settable by name all the
+    /// same (`--set`). A test checks this is exactly the set of fields the JSON can omit.
     pub const OPTIONAL_FIELDS: &'static [&'static str] = &[
         "release_offset_m",
         "release_velocity_m_s",
@@ -272,6 +273,9 @@ impl Scene {
         "support_damping_isotropic",
         "stop_speed_rpm",
         "thermal",
+        "solver.method",
+        "solver.free_flight_gap_bound",
+        "solver.race_atol_scale",
     ];
 
     /// The paper's scene: Tables 2-4 with the MODEL-NOTES defaults, 8000 r/min, mu 0.1.

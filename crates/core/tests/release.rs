@@ -1,15 +1,68 @@
 //! The optional release state (issue 7): rotor offset and velocity, race spin at release.
 //! Defaults reproduce the MODEL-NOTES release exactly; non-defaults are tested by physics.
 
+use std::collections::BTreeSet;
 use whirlmap_core::{simulate, DropOptions, Scene};
+
+/// Every dotted key path of a JSON value's objects.
+fn paths(v: &serde_json::Value, prefix: &str, out: &mut BTreeSet<String>) {
+    if let serde_json::Value::Object(m) = v {
+        for (k, x) in m {
+            let p = if prefix.is_empty() {
+                k.clone()
+            } else {
+                format!("{prefix}.{k}")
+            };
+            paths(x, &p, out);
+            out.insert(p);
+        }
+    }
+}
+
+#[test]
+fn optional_fields_are_exactly_those_the_json_omits_at_their_default() {
+    let s = Scene::paper();
+    let mut t = s.clone();
+    t.release_offset_m = [1e-6, 0.0];
+    t.release_velocity_m_s = [0.0, -1e-3];
+    t.race_speed_rad_s = 1.0;
+    t.quasi_static_race = true;
+    t.support_damping_isotropic = true;
+    t.stop_speed_rpm = Some(100.0);
+    t.thermal = Some(Default::default());
+    t.solver.method = whirlmap_core::Method::Ros34pw2;
+    t.solver.free_flight_gap_bound = true;
+    t.solver.race_atol_scale = 10.0;
+    let (mut a, mut b) = (BTreeSet::new(), BTreeSet::new());
+    paths(&serde_json::to_value(&s).unwrap(), "", &mut a);
+    paths(&serde_json::to_value(&t).unwrap(), "", &mut b);
+    // The keys only the non-default scene has, without those inside a new section.
+    let new: BTreeSet<String> = b.difference(&a).cloned().collect();
+    let top: BTreeSet<&str> = new
+        .iter()
+        .filter(|p| !new.iter().any(|q| p.starts_with(&format!("{q}."))))
+        .map(String::as_str)
+        .collect();
+    let listed: BTreeSet<&str> = Scene::OPTIONAL_FIELDS.iter().copied().collect();
+    assert_eq!(top, listed);
+    // And no field is skipped at its default without being listed: the scene source has
+    // one `skip_serializing_if` per listed field (a new one must be added to the list and
+    // to the scene above).
+    let src = include_str!("../src/scene.rs");
+    assert_eq!(
+        src.matches("skip_serializing_if").count(),
+        Scene::OPTIONAL_FIELDS.len()
+    );
+}
 
 #[test]
 fn default_release_fields_are_left_out_of_the_json_and_the_hash() {
     let s = Scene::paper();
-    let text = serde_json::to_string(&s).unwrap();
+    let mut present = BTreeSet::new();
+    paths(&serde_json::to_value(&s).unwrap(), "", &mut present);
     for key in Scene::OPTIONAL_FIELDS {
         assert!(
-            !text.contains(key),
+            !present.contains(*key),
             "{key} must not be serialised at its default"
         );
     }

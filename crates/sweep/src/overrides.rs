@@ -41,37 +41,9 @@ pub fn apply_assignment(scene: &mut Scene, assignment: &str) -> Result<(), Overr
     apply(scene, key.trim(), value)
 }
 
-/// Fields the canonical JSON leaves out while they hold their default (so scene hashes of
-/// older records stay valid) are still settable: put their defaults back in.
-fn show_optional_fields(root: &mut Value) {
-    if let Value::Object(m) = root {
-        m.entry("quasi_static_race").or_insert(Value::Bool(false));
-        m.entry("support_damping_isotropic")
-            .or_insert(Value::Bool(false));
-        m.entry("stop_speed_rpm").or_insert(Value::Null);
-        for key in ["release_offset_m", "release_velocity_m_s"] {
-            m.entry(key).or_insert(serde_json::json!([0.0, 0.0]));
-        }
-        m.entry("race_speed_rad_s")
-            .or_insert(serde_json::json!(0.0));
-        if let Some(Value::Object(solver)) = m.get_mut("solver") {
-            solver
-                .entry("method")
-                .or_insert(Value::String("dopri5".into()));
-            solver
-                .entry("free_flight_gap_bound")
-                .or_insert(Value::Bool(false));
-            solver
-                .entry("race_atol_scale")
-                .or_insert(serde_json::json!(1.0));
-        }
-    }
-}
-
 /// Sets the scene parameter `key` (dotted for nested fields) to `value`.
 pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideError> {
     let mut root = serde_json::to_value(&*scene).expect("a scene serialises");
-    show_optional_fields(&mut root);
     let mut node = &mut root;
     let parts: Vec<&str> = key.split('.').collect();
     for (i, part) in parts.iter().enumerate() {
@@ -84,12 +56,18 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
                 });
             }
         };
-        // Optional scene fields are absent from the JSON while at their default.
-        let optional = i == 0 && Scene::OPTIONAL_FIELDS.contains(part);
+        // Optional scene fields are absent from the JSON while at their default; setting one
+        // inserts it (absent and default deserialise alike).
+        let path = parts[..=i].join(".");
+        let optional = Scene::OPTIONAL_FIELDS.contains(&path.as_str());
         if !obj.contains_key(*part) && !optional {
+            let parent = parts[..i].join(".");
             let mut known = obj.keys().cloned().collect::<Vec<_>>();
-            if i == 0 {
-                known.extend(Scene::OPTIONAL_FIELDS.iter().map(|k| k.to_string()));
+            for f in Scene::OPTIONAL_FIELDS {
+                let (dir, name) = f.rsplit_once('.').unwrap_or(("", f));
+                if dir == parent && !known.iter().any(|k| k == name) {
+                    known.push(name.to_string());
+                }
             }
             let known = known.join(", ");
             return Err(OverrideError::UnknownKey {
@@ -137,6 +115,26 @@ mod tests {
         apply_assignment(&mut s, "thermal={}").unwrap();
         apply_assignment(&mut s, "thermal.macro_step_s=0.002").unwrap();
         assert_eq!(s.thermal.as_ref().unwrap().macro_step_s, 0.002);
+        // Every listed field, nested ones too, is settable from a scene that omits it.
+        for (key, value) in [
+            ("support_damping_isotropic", "true"),
+            ("release_velocity_m_s", "[0, -1e-3]"),
+            ("solver.free_flight_gap_bound", "true"),
+            ("solver.race_atol_scale", "100"),
+            ("solver.method", "ros34pw2"),
+        ] {
+            let mut t = Scene::paper();
+            apply_assignment(&mut t, &format!("{key}={value}")).unwrap();
+            assert_ne!(t, Scene::paper(), "{key}");
+        }
+        // A misspelt nested key lists the solver's optional fields as well.
+        let e = apply_assignment(&mut s, "solver.race_atol=10")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("race_atol_scale") && e.contains("rtol") && !e.contains("clearance_m"),
+            "{e}"
+        );
     }
 
     #[test]
