@@ -24,24 +24,24 @@ pub(super) struct StepLaw {
     pub fac_max: f64,
 }
 
-/// The state every adaptive stepper keeps besides its stages.
+/// The state every adaptive stepper keeps besides its stages (see [`super::Stepper::core`]).
 #[derive(Debug, Clone)]
-pub(super) struct StepCore<const N: usize> {
+pub struct StepCore<const N: usize> {
     /// Tolerances, limits and the optional fixed step.
-    pub ctl: StepControl<N>,
+    pub(super) ctl: StepControl<N>,
     /// Work counters, accumulated over every call.
-    pub stats: Stats,
+    pub(super) stats: Stats,
     /// The next step to try (s); 0 before the first restart.
-    pub h: f64,
+    pub(super) h: f64,
     /// The previous accepted error norm (PI memory; floored at 1e-4).
-    pub err_old: f64,
+    pub(super) err_old: f64,
     /// The interpolant of the last accepted step.
-    pub dense: Dense<N>,
+    pub(super) dense: Dense<N>,
 }
 
 impl<const N: usize> StepCore<N> {
     /// A core with no step-size history whose interpolant uses `terms` coefficient vectors.
-    pub fn new(ctl: StepControl<N>, terms: usize) -> Self {
+    pub(super) fn new(ctl: StepControl<N>, terms: usize) -> Self {
         Self {
             ctl,
             stats: Stats::default(),
@@ -60,7 +60,7 @@ impl<const N: usize> StepCore<N> {
 
     /// After a restart's derivative `dy` at `y`: the fixed step, or on the first call an
     /// initial step (Hairer's `hinit`, capped by the system's largest step).
-    pub fn restart<S: OdeSystem<N>>(&mut self, sys: &S, y: &[f64; N], dy: &[f64; N]) {
+    pub(super) fn restart<S: OdeSystem<N>>(&mut self, sys: &S, y: &[f64; N], dy: &[f64; N]) {
         self.stats.rhs_evals += 1;
         if let Some(hf) = self.ctl.fixed_step {
             self.h = hf;
@@ -72,14 +72,14 @@ impl<const N: usize> StepCore<N> {
     /// Caps the next step at `h_s` (the controller grows it again from there). Used after a
     /// mode switch: a contact law like `delta^(10/9)` is not smooth where the new mode starts,
     /// so the embedded error estimate is least reliable on the first step after it.
-    pub fn cap_next_step(&mut self, h_s: f64) {
+    pub(super) fn cap_next_step(&mut self, h_s: f64) {
         if self.ctl.fixed_step.is_none() {
             self.h = self.h.min(h_s);
         }
     }
 
     /// Cuts the last accepted step at `t_cut` and returns its interpolant.
-    pub fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
+    pub(super) fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
         self.dense.t_end = t_cut;
         &self.dense
     }
@@ -88,7 +88,7 @@ impl<const N: usize> StepCore<N> {
     /// trial and size; the next step size is then already set. `attempt(core, h)` returns a
     /// trial and its error norm (NaN when the step could not be formed). Errors: the attempt
     /// budget, a step below `h_min`, and a non-finite norm at the smallest or a fixed step.
-    pub fn control<T>(
+    pub(super) fn control<T>(
         &mut self,
         law: &StepLaw,
         t: f64,

@@ -22,7 +22,7 @@
 
 use super::control::{StepCore, StepLaw};
 use super::dopri5::{Dense, StepControl};
-use super::{OdeSystem, Stats, Stepper};
+use super::{OdeSystem, Stepper};
 use crate::error::SolveError;
 
 /// Stages of the step (12) and of the dense output (16).
@@ -345,20 +345,11 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         Ok(&self.core.dense)
     }
 
-    fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
-        self.core.cut_last_step(t_cut)
+    fn core(&self) -> &StepCore<N> {
+        &self.core
     }
-    fn last_dense(&self) -> &Dense<N> {
-        &self.core.dense
-    }
-    fn cap_next_step(&mut self, h_s: f64) {
-        self.core.cap_next_step(h_s)
-    }
-    fn stats(&self) -> Stats {
-        self.core.stats
-    }
-    fn count_event(&mut self) {
-        self.core.stats.events += 1;
+    fn core_mut(&mut self) -> &mut StepCore<N> {
+        &mut self.core
     }
 }
 

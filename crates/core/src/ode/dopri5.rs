@@ -5,7 +5,7 @@
 //! G. Wanner, "Solving Ordinary Differential Equations I", 2nd ed., Sec. II.4-II.6 (DOPRI5).
 
 use super::control::{StepCore, StepLaw};
-use super::{OdeSystem, Stats, Stepper};
+use super::{OdeSystem, Stepper};
 use crate::error::SolveError;
 
 const C2: f64 = 1.0 / 5.0;
@@ -148,7 +148,6 @@ pub(super) fn initial_step<const N: usize>(
 pub struct Dopri5<const N: usize> {
     core: StepCore<N>,
     k1: [f64; N],
-    dy_last: [f64; N],
 }
 
 /// Hairer's PI controller for DOPRI5: safety 0.9, beta 0.04, step ratio in [1/5, 10].
@@ -166,34 +165,7 @@ impl<const N: usize> Dopri5<N> {
         Self {
             core: StepCore::new(ctl, 5),
             k1: [0.0; N],
-            dy_last: [0.0; N],
         }
-    }
-
-    /// Evaluates the derivative at `(t, y)` (a clean restart after a mode switch) and, on the
-    /// first call, picks an initial step (Hairer's `hinit`).
-    pub fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
-        sys.rhs(t, y, &mut self.k1);
-        self.core.restart(sys, y, &self.k1);
-    }
-
-    /// Caps the next step at `h_s` (see [`StepCore::cap_next_step`]).
-    pub fn cap_next_step(&mut self, h_s: f64) {
-        self.core.cap_next_step(h_s)
-    }
-
-    /// The interpolant of the last accepted step.
-    pub fn last_dense(&self) -> &Dense<N> {
-        &self.core.dense
-    }
-
-    /// Work counters, accumulated over every call.
-    pub fn stats(&self) -> Stats {
-        self.core.stats
-    }
-    /// The derivative at the end of the last accepted step.
-    pub fn last_dy(&self) -> &[f64; N] {
-        &self.dy_last
     }
 
     /// Builds the dense output of an accepted step and keeps k7 as the next k1 (FSAL).
@@ -231,31 +203,7 @@ impl<const N: usize> Dopri5<N> {
             y1: *y_new,
         };
         self.k1 = *k7;
-        self.dy_last = *k7;
         self.core.stats.steps += 1;
-    }
-
-    /// Cuts the last accepted step at `t_cut` (an event time inside it) and returns it. The
-    /// state there comes from the interpolant, on the new side of the located crossing; the
-    /// next [`Dopri5::restart`] re-evaluates the derivative there.
-    pub fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
-        self.core.cut_last_step(t_cut)
-    }
-
-    /// Takes one accepted step from `(t, y)` of at most `h_cap`, retrying rejected attempts.
-    pub fn step<S: OdeSystem<N>>(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &[f64; N],
-        h_cap: f64,
-    ) -> Result<&Dense<N>, SolveError> {
-        let k1 = &self.k1;
-        let ((y_new, k7, k), h) = self
-            .core
-            .control(&LAW, t, h_cap, |core, h| attempt(core, k1, sys, t, y, h))?;
-        self.accept(t, y, h, &y_new, &k7, &k);
-        Ok(&self.core.dense)
     }
 }
 
@@ -312,7 +260,8 @@ fn attempt<S: OdeSystem<N>, const N: usize>(
 
 impl<const N: usize> Stepper<N> for Dopri5<N> {
     fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
-        Dopri5::restart(self, sys, t, y)
+        sys.rhs(t, y, &mut self.k1);
+        self.core.restart(sys, y, &self.k1);
     }
     fn step<S: OdeSystem<N>>(
         &mut self,
@@ -321,22 +270,18 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError> {
-        Dopri5::step(self, sys, t, y, h_cap)
+        let k1 = &self.k1;
+        let ((y_new, k7, k), h) = self
+            .core
+            .control(&LAW, t, h_cap, |core, h| attempt(core, k1, sys, t, y, h))?;
+        self.accept(t, y, h, &y_new, &k7, &k);
+        Ok(&self.core.dense)
     }
-    fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
-        Dopri5::cut_last_step(self, t_cut)
+    fn core(&self) -> &StepCore<N> {
+        &self.core
     }
-    fn last_dense(&self) -> &Dense<N> {
-        &self.core.dense
-    }
-    fn cap_next_step(&mut self, h_s: f64) {
-        Dopri5::cap_next_step(self, h_s)
-    }
-    fn stats(&self) -> Stats {
-        self.core.stats
-    }
-    fn count_event(&mut self) {
-        self.core.stats.events += 1;
+    fn core_mut(&mut self) -> &mut StepCore<N> {
+        &mut self.core
     }
 }
 

@@ -13,6 +13,7 @@ mod dopri5;
 mod events;
 mod rosw;
 
+pub use control::StepCore;
 pub use dop853::Dop853;
 pub use dopri5::{Dense, Dopri5, StepControl};
 pub use events::locate_crossing;
@@ -142,16 +143,32 @@ pub trait Stepper<const N: usize> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError>;
-    /// Cuts the last accepted step at `t_cut` (an event time inside it) and returns it.
-    fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N>;
+    /// The step-size history, counters and last interpolant every stepper keeps.
+    fn core(&self) -> &StepCore<N>;
+    /// [`Stepper::core`], mutably.
+    fn core_mut(&mut self) -> &mut StepCore<N>;
+    /// Cuts the last accepted step at `t_cut` (an event time inside it) and returns it. The
+    /// state there comes from the interpolant; the next restart re-evaluates the derivative.
+    fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
+        self.core_mut().cut_last_step(t_cut)
+    }
     /// The interpolant of the last accepted step.
-    fn last_dense(&self) -> &Dense<N>;
-    /// Caps the next step at `h_s` (after a mode switch).
-    fn cap_next_step(&mut self, h_s: f64);
+    fn last_dense(&self) -> &Dense<N> {
+        &self.core().dense
+    }
+    /// Caps the next step at `h_s` (after a mode switch: the error estimate is least reliable
+    /// on the first step of a new mode; the controller grows the step again from there).
+    fn cap_next_step(&mut self, h_s: f64) {
+        self.core_mut().cap_next_step(h_s)
+    }
     /// Work counters, accumulated over every call.
-    fn stats(&self) -> Stats;
+    fn stats(&self) -> Stats {
+        self.core().stats
+    }
     /// Counts one located event.
-    fn count_event(&mut self);
+    fn count_event(&mut self) {
+        self.core_mut().stats.events += 1;
+    }
 }
 
 /// Integrates `sys` from `(t, y)` towards `t_end`, advancing `t` and `y` in place.

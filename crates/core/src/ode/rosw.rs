@@ -17,7 +17,7 @@
 //! stage.
 
 use super::control::{StepCore, StepLaw};
-use super::{Dense, OdeSystem, Stats, StepControl, Stepper, StiffJacobian, MAX_STIFF};
+use super::{Dense, OdeSystem, StepControl, Stepper, StiffJacobian, MAX_STIFF};
 use crate::error::SolveError;
 
 const GAMMA: f64 = 4.358_665_215_084_590_0e-1;
@@ -333,20 +333,11 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
         Ok(&self.core.dense)
     }
 
-    fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
-        self.core.cut_last_step(t_cut)
+    fn core(&self) -> &StepCore<N> {
+        &self.core
     }
-    fn last_dense(&self) -> &Dense<N> {
-        &self.core.dense
-    }
-    fn cap_next_step(&mut self, h_s: f64) {
-        self.core.cap_next_step(h_s)
-    }
-    fn stats(&self) -> Stats {
-        self.core.stats
-    }
-    fn count_event(&mut self) {
-        self.core.stats.events += 1;
+    fn core_mut(&mut self) -> &mut StepCore<N> {
+        &mut self.core
     }
 }
 

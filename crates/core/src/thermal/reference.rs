@@ -9,7 +9,9 @@ use super::ThermalModel;
 use crate::drop::{next_mode, tolerances, STEP_AFTER_SWITCH_S};
 use crate::error::SolveError;
 use crate::model::{ix, DropSystem, N};
-use crate::ode::{integrate, Dopri5, NoObserver, OdeSystem, Stats, StepControl, Stop, MAX_GUARDS};
+use crate::ode::{
+    integrate, Dopri5, NoObserver, OdeSystem, Stats, StepControl, Stepper, Stop, MAX_GUARDS,
+};
 use crate::scene::Scene;
 
 /// State size: the dynamic state, then the seven temperature rises (K).
