@@ -263,6 +263,9 @@ pub struct Measured {
     pub whirl_frequency_hz: f64,
     /// Energy audit residual.
     pub energy_residual_rel: f64,
+    /// Friction heat over the whole drop (J), the integral of H_s: unlike the peaks above it
+    /// depends on the whole stick/slip history (a contact that sticks makes no heat).
+    pub friction_heat_j: f64,
     /// RHS evaluations.
     pub rhs_evals: u64,
     /// Accepted steps.
@@ -289,6 +292,7 @@ pub fn measure(scene: &Scene, duration_s: f64, record_orbit: bool) -> Result<Mea
         peak_heat_power_w: f.peak_heat_power_w,
         whirl_frequency_hz: f.whirl_frequency_hz,
         energy_residual_rel: r.energy.residual_rel,
+        friction_heat_j: r.energy.friction_heat_j,
         rhs_evals: r.stats.rhs_evals,
         steps: r.stats.steps,
         wall_ms,
@@ -306,6 +310,8 @@ pub struct Errors {
     pub peak_heat_rel: f64,
     /// Absolute error of the whirl frequency (Hz).
     pub whirl_frequency_abs_hz: f64,
+    /// Relative error of the friction heat over the drop.
+    pub friction_heat_rel: f64,
     /// Whether the class agrees.
     pub class_agrees: bool,
 }
@@ -319,11 +325,14 @@ impl Errors {
             max_force_rel: rel(m.max_contact_force_n, reference.max_contact_force_n),
             peak_heat_rel: rel(m.peak_heat_power_w, reference.peak_heat_power_w),
             whirl_frequency_abs_hz: (m.whirl_frequency_hz - reference.whirl_frequency_hz).abs(),
+            friction_heat_rel: rel(m.friction_heat_j, reference.friction_heat_j),
             class_agrees: m.class == reference.class,
         }
     }
 
-    /// The largest of the three relative errors: the y value of the work-precision chart.
+    /// The largest of the three relative errors of the issue's outputs (first and maximum
+    /// force, peak heat power): the y value of the work-precision chart. The friction heat's
+    /// error is reported beside it, not in it.
     pub fn worst_rel(&self) -> f64 {
         self.first_force_rel
             .max(self.max_force_rel)
@@ -449,12 +458,13 @@ pub fn to_csv(study: &Study) -> String {
     let mut out = String::from(
         "case,setting,rtol,status,class,class_agrees,first_force_rel_err,max_force_rel_err,\
          peak_heat_rel_err,whirl_freq_abs_err_hz,first_contact_force_n,max_contact_force_n,\
-         peak_heat_power_w,whirl_frequency_hz,energy_residual_rel,rhs_evals,steps,wall_ms\n",
+         peak_heat_power_w,whirl_frequency_hz,energy_residual_rel,rhs_evals,steps,wall_ms,\
+         friction_heat_rel_err,friction_heat_j\n",
     );
     for r in &study.rows {
         match &r.result {
             Ok((m, e)) => out.push_str(&format!(
-                "{},{},{:e},ok,{},{},{:e},{:e},{:e},{:e},{},{},{},{},{:e},{},{},{:.3}\n",
+                "{},{},{:e},ok,{},{},{:e},{:e},{:e},{:e},{},{},{},{},{:e},{},{},{:.3},{:e},{}\n",
                 r.case,
                 r.setting,
                 r.rtol,
@@ -471,10 +481,12 @@ pub fn to_csv(study: &Study) -> String {
                 m.energy_residual_rel,
                 m.rhs_evals,
                 m.steps,
-                m.wall_ms
+                m.wall_ms,
+                e.friction_heat_rel,
+                m.friction_heat_j
             )),
             Err(e) => out.push_str(&format!(
-                "{},{},{:e},\"failed: {}\",,,,,,,,,,,,,,\n",
+                "{},{},{:e},\"failed: {}\",,,,,,,,,,,,,,,,\n",
                 r.case,
                 r.setting,
                 r.rtol,
@@ -498,34 +510,36 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
     let mut out = format!(
         "# Work-precision study `{}`\n\nReference: the full model, DOP853 at rtol {:e}; DOPRI5 at the same \
          tolerance confirms it (the last columns: its relative differences, the reference's own \
-         uncertainty). Errors are relative (forces, heat power) or absolute (whirl frequency, \
-         Hz); cost is RHS evaluations, steps and wall time on one thread of this machine.\n\n",
+         uncertainty). Errors are relative (forces, heat power, friction heat over the drop) or \
+         absolute (whirl frequency, Hz); cost is RHS evaluations, steps and wall time on one thread of this machine.\n\n",
         spec.name, spec.reference_rtol
     );
-    out.push_str("| case | class | first force (N) | max force (N) | peak heat (W) | whirl (Hz) | DOP853 RHS evals | DOPRI5 class | DOPRI5 diff first / max / heat |\n|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| case | class | first force (N) | max force (N) | peak heat (W) | whirl (Hz) | friction heat (J) | DOP853 RHS evals | DOPRI5 class | DOPRI5 diff first / max / heat / friction heat |\n|---|---|---|---|---|---|---|---|---|---|\n");
     for r in &study.references {
         let m = &r.dop853;
         let (c5, diff) = match (&r.dopri5, &r.agreement) {
             (Ok(d), Some(a)) => (
                 d.class.name().to_string(),
                 format!(
-                    "{} / {} / {}",
+                    "{} / {} / {} / {}",
                     pct(a.first_force_rel),
                     pct(a.max_force_rel),
-                    pct(a.peak_heat_rel)
+                    pct(a.peak_heat_rel),
+                    pct(a.friction_heat_rel)
                 ),
             ),
             (Err(e), _) => (format!("failed: {e}"), String::new()),
             _ => (String::new(), String::new()),
         };
         out.push_str(&format!(
-            "| {} | {} | {:.2} | {:.2} | {:.1} | {:.3} | {} | {} | {} |\n",
+            "| {} | {} | {:.2} | {:.2} | {:.1} | {:.3} | {:.4} | {} | {} | {} |\n",
             r.case,
             m.class.name(),
             m.first_contact_force_n,
             m.max_contact_force_n,
             m.peak_heat_power_w,
             m.whirl_frequency_hz,
+            m.friction_heat_j,
             m.rhs_evals,
             c5,
             diff
@@ -533,13 +547,13 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
     }
     for reference in &study.references {
         out.push_str(&format!(
-            "\n## {}\n\n| setting | rtol | class | first force err | max force err | heat err | whirl err (Hz) | RHS evals | steps | wall (ms) |\n|---|---|---|---|---|---|---|---|---|---|\n",
+            "\n## {}\n\n| setting | rtol | class | first force err | max force err | heat err | whirl err (Hz) | friction heat err | RHS evals | steps | wall (ms) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
             reference.case
         ));
         for r in study.rows.iter().filter(|r| r.case == reference.case) {
             match &r.result {
                 Ok((m, e)) => out.push_str(&format!(
-                    "| {} | {:.0e} | {}{} | {} | {} | {} | {:.2e} | {} | {} | {:.1} |\n",
+                    "| {} | {:.0e} | {}{} | {} | {} | {} | {:.2e} | {} | {} | {} | {:.1} |\n",
                     r.setting,
                     r.rtol,
                     m.class.name(),
@@ -548,12 +562,13 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
                     pct(e.max_force_rel),
                     pct(e.peak_heat_rel),
                     e.whirl_frequency_abs_hz,
+                    pct(e.friction_heat_rel),
                     m.rhs_evals,
                     m.steps,
                     m.wall_ms
                 )),
                 Err(e) => out.push_str(&format!(
-                    "| {} | {:.0e} | failed: {} | | | | | | | |\n",
+                    "| {} | {:.0e} | failed: {} | | | | | | | | |\n",
                     r.setting, r.rtol, e
                 )),
             }
@@ -575,6 +590,7 @@ mod tests {
             peak_heat_power_w: 90.0,
             whirl_frequency_hz: 1.5,
             energy_residual_rel: 0.0,
+            friction_heat_j: 3.0,
             rhs_evals: 1,
             steps: 1,
             wall_ms: 0.0,
@@ -583,6 +599,7 @@ mod tests {
             first_contact_force_n: 100.0,
             peak_heat_power_w: 100.0,
             whirl_frequency_hz: 1.0,
+            friction_heat_j: 4.0,
             class: OrbitClass::BackwardWhirl,
             ..m
         };
@@ -591,6 +608,7 @@ mod tests {
         assert_eq!(e.max_force_rel, 0.0);
         assert!((e.peak_heat_rel - 0.1).abs() < 1e-12);
         assert!((e.whirl_frequency_abs_hz - 0.5).abs() < 1e-12);
+        assert!((e.friction_heat_rel - 0.25).abs() < 1e-12);
         assert!(!e.class_agrees);
         assert!((e.worst_rel() - 0.1).abs() < 1e-12);
     }
