@@ -476,6 +476,14 @@ fn block_on_a_plane_sticks_then_slips_at_the_closed_form_times() {
 fn energy_audit_closes_on_full_drops() {
     let mut unbalanced = scene(8000.0, 0.2);
     unbalanced.unbalance_m = 20e-6;
+    // A stick-to-slip switch where the sticking contact's v_rel has drifted against the
+    // friction demand (at 78.7 ms): before the mode-entry rule of `drop.rs`
+    // (`slip_along_drift`) the slip started with its guard already negative, unwatched, and
+    // the friction ran v_rel to -100 m/s making 1 kJ.
+    let mut loose = scene(8000.0, 0.3);
+    loose.solver.method = whirlmap_core::Method::Ros34pw2;
+    loose.solver.free_flight_gap_bound = true;
+    loose.solver.rtol = 3e-4;
     let cases = [
         ("8000 r/min mu 0.1", scene(8000.0, 0.1)),
         ("8000 r/min mu 0.3", scene(8000.0, 0.3)),
@@ -670,18 +678,30 @@ impl Observer<DropSystem, N> for SignWatch {
 fn normal_force_is_never_negative_and_friction_never_adds_energy() {
     let mut unbalanced = scene(8000.0, 0.2);
     unbalanced.unbalance_m = 20e-6;
+    // A stick-to-slip switch where the sticking contact's v_rel has drifted against the
+    // friction demand (at 78.7 ms): before the mode-entry rule of `drop.rs`
+    // (`slip_along_drift`) the slip started with its guard already negative, unwatched, and
+    // the friction ran v_rel to -100 m/s making 1 kJ.
+    let mut loose = scene(8000.0, 0.3);
+    loose.solver.method = whirlmap_core::Method::Ros34pw2;
+    loose.solver.free_flight_gap_bound = true;
+    loose.solver.rtol = 3e-4;
     let cases = [
         // Pendulum cases: 0.3 s, through the race's spin-up to rolling (stick phases) and
         // the settling of the pendulum, where the rotor grazes the race.
-        ("8000 r/min mu 0.1", scene(8000.0, 0.1), 0.3),
-        ("3000 r/min mu 0.3", scene(3000.0, 0.3), 0.3),
+        ("8000 r/min mu 0.1", scene(8000.0, 0.1), 0.3, true),
+        ("3000 r/min mu 0.3", scene(3000.0, 0.3), 0.3, true),
         // Whirl cases: 0.05 s ends before the 5-turn rule would stop `simulate` (55-65 ms).
-        ("8000 r/min mu 0.4 whirl", scene(8000.0, 0.4), 0.05),
-        ("8000 r/min mu 0.2 e 20 um whirl", unbalanced, 0.05),
+        ("8000 r/min mu 0.4 whirl", scene(8000.0, 0.4), 0.05, true),
+        ("8000 r/min mu 0.2 e 20 um whirl", unbalanced, 0.05, true),
+        // The stick-drift and heat-drop bounds below are DOPRI5's at its rtol; ROS34PW2 at
+        // rtol 3e-4 drifts more while sticking (measured: 15x the bound, heat falling by
+        // 1.2e-7 J), so this case checks the signs of F_n and of the slipping F_t v_rel.
+        ("8000 r/min mu 0.3 ROS34PW2 rtol 3e-4", loose, 0.3, false),
     ];
     let mut failures = Vec::new();
     let mut stick_samples = 0;
-    for (name, s, dur) in cases {
+    for (name, s, dur, stick_bounds) in cases {
         let mut w = SignWatch {
             v_drift: s.solver.rtol * (2.0 * s.gravity_m_s2 * s.clearance_m).sqrt(),
             ..Default::default()
@@ -718,7 +738,7 @@ fn normal_force_is_never_negative_and_friction_never_adds_energy() {
         // scale is the impact speed v_ref = sqrt(2 g s) (the solver's own velocity scale;
         // whirl orbits reach ~2 v_ref). So |v_rel| <= rtol v_ref, i.e. F_t v_rel >=
         // -|F_t| rtol v_ref (measured: up to ~0.2 of that, printed as the ratio).
-        if w.max_stick_ratio > 1.0 {
+        if stick_bounds && w.max_stick_ratio > 1.0 {
             failures.push(format!(
                 "{name}: while sticking F_t v_rel = -{:.2} |F_t| rtol v_ref at t = {:.9} s",
                 w.max_stick_ratio, w.max_stick_ratio_t
@@ -728,7 +748,7 @@ fn normal_force_is_never_negative_and_friction_never_adds_energy() {
         // (rtol * m_r g s * 1e-2 ~ 8.5e-10 J): a negative Runge-Kutta weight acting on a
         // power that is ~0 in stick is the only way down.
         let atol_e = s.solver.rtol * Bodies::of(&s).m_r * s.gravity_m_s2 * s.clearance_m * 1e-2;
-        if w.max_heat_drop > atol_e {
+        if stick_bounds && w.max_heat_drop > atol_e {
             failures.push(format!(
                 "{name}: friction heat fell by {:e} J",
                 w.max_heat_drop
