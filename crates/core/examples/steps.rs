@@ -5,7 +5,11 @@
 use std::ops::ControlFlow;
 use whirlmap_core::ode::{Observer, StepView};
 use whirlmap_core::*;
-struct Rec(Vec<(f64, f64, bool, i32)>, model::ModelEvals);
+struct Rec(
+    Vec<(f64, f64, bool, i32)>,
+    model::ModelEvals,
+    Vec<(f64, f64, f64)>,
+);
 impl Observer<model::DropSystem, { model::N }> for Rec {
     fn on_step(
         &mut self,
@@ -18,6 +22,12 @@ impl Observer<model::DropSystem, { model::N }> for Rec {
             model::Slip::Slipping(x) => x as i32,
         };
         self.0.push((s.dense.t0(), s.dense.t1(), m.contact, sl));
+        if !m.contact {
+            use whirlmap_core::ode::OdeSystem;
+            let cap = sys.max_step_at(s.dense.t0(), &s.dense.y0());
+            self.2
+                .push((s.dense.t0(), s.dense.t1() - s.dense.t0(), cap));
+        }
         self.1 = sys.model_evals();
         ControlFlow::Continue(())
     }
@@ -41,7 +51,7 @@ fn main() {
             _ => panic!("{k}"),
         }
     }
-    let mut rec = Rec(Vec::new(), Default::default());
+    let mut rec = Rec(Vec::new(), Default::default(), Vec::new());
     let r = simulate_observed(
         &s,
         &DropOptions {
@@ -66,6 +76,14 @@ fn main() {
         w[b][k] += 1;
         w[b][3] += 1;
     }
+    let capped = rec.2.iter().filter(|r| r.1 >= 0.999 * r.2).count();
+    let hmean = rec.2.iter().map(|r| r.1).sum::<f64>() / rec.2.len().max(1) as f64;
+    println!(
+        "free steps {}, at the step cap {}, mean h {:.3e} s",
+        rec.2.len(),
+        capped,
+        hmean
+    );
     println!("window  free  stick  slip  total");
     for (i, r) in w.iter().enumerate() {
         println!(

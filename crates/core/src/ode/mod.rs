@@ -39,6 +39,12 @@ pub struct StiffJacobian {
     pub len: usize,
     /// The restricted Jacobian (1/s units of the state's components).
     pub jac: [[f64; MAX_STIFF]; MAX_STIFF],
+    /// How many leading components are *kinematic*: positions `q_a` (a < `kinematic`) whose
+    /// rows say exactly `q_a' = y_{idx[kinematic + a]}` (`jac[a][kinematic + a] = 1`, every
+    /// other entry of the row zero). The stepper then eliminates them and factors only the
+    /// remaining `len - kinematic` components (a Schur complement). 0 (the default of
+    /// [`StiffJacobian::over`]): no such structure is claimed. At most `len / 2`.
+    pub kinematic: usize,
 }
 
 impl StiffJacobian {
@@ -48,6 +54,7 @@ impl StiffJacobian {
             idx: [0; MAX_STIFF],
             len: idx.len(),
             jac: [[0.0; MAX_STIFF]; MAX_STIFF],
+            kinematic: 0,
         };
         s.idx[..idx.len()].copy_from_slice(idx);
         s
