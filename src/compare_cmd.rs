@@ -19,7 +19,7 @@ pub struct CompareArgs {
     /// Relative change of the peak heat power that counts as changed.
     #[arg(long, allow_negative_numbers = true, default_value_t = Thresholds::default().power_rel)]
     power_rel: f64,
-    /// The Markdown report; the class map goes beside it as <stem>-classes.png. Default
+    /// The Markdown report; the class map goes beside it as `<stem>-classes.png`. Default
     /// NEW/compare.md.
     #[arg(long)]
     out: Option<PathBuf>,

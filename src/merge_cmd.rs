@@ -16,7 +16,7 @@ pub struct MergeArgs {
     /// The shard output folders (each written by `whirlmap sweep --shard I --shards N`).
     #[arg(required = true)]
     dirs: Vec<PathBuf>,
-    /// Output folder; default: results/<name> of the shards' spec.
+    /// Output folder; default: `results/<name>` of the shards' spec.
     #[arg(long)]
     out: Option<PathBuf>,
 }

@@ -27,7 +27,7 @@ pub struct SweepArgs {
     #[arg(long)]
     pub(crate) no_progress: bool,
     /// Run only shard I of --shards N (0 <= I < N): grid points, critical searches and orbit
-    /// panels whose position mod N is I; default --out results/<name>/shard-I-of-N. Join the
+    /// panels whose position mod N is I; default --out `results/<name>/shard-I-of-N`. Join the
     /// shards with `whirlmap merge`.
     #[arg(long, requires = "shards", value_name = "I")]
     shard: Option<usize>,

@@ -6,7 +6,7 @@
 //! - [`network`]: eqs. 18-25 with Table 1's resistances, stepped exactly.
 //! - [`expansion`]: eqs. 26-30.
 //! - [`params`]: every material, geometry and coupling number, with its source.
-//! - [`reference`]: the fully coupled reference (network states inside the dynamic ODE).
+//! - [`reference`](mod@reference): the fully coupled reference (network states inside the dynamic ODE).
 //!
 //! ## Two time scales
 //! The contact moves on microseconds, the network on seconds to minutes. The drop is cut into

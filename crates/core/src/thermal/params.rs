@@ -3,15 +3,15 @@
 //! each field documented with unit, default, allowed range and source; validated once.
 //!
 //! Sources quoted below:
-//! - [ASM] ASM Handbook Vol. 1, *Properties and Selection: Irons, Steels* (1990): AISI 52100
+//! - \[ASM\] ASM Handbook Vol. 1, *Properties and Selection: Irons, Steels* (1990): AISI 52100
 //!   bearing steel 46.6 W/(m K), 475 J/(kg K), 7810 kg/m^3, 11.9e-6 1/K (20-100 C); carbon and
 //!   low-alloy shaft steels (AISI 1045/4140) about 44.5 W/(m K), 475 J/(kg K), 7850 kg/m^3.
-//! - [Harris] T. A. Harris, M. N. Kotzalas, *Rolling Bearing Analysis*, 5th ed. (2006),
+//! - \[Harris\] T. A. Harris, M. N. Kotzalas, *Rolling Bearing Analysis*, 5th ed. (2006),
 //!   Ch. 15 (friction heat, contact-cage speeds) and App. (steel: E = 208 GPa, nu = 0.3).
-//! - [Incropera] F. P. Incropera et al., *Fundamentals of Heat and Mass Transfer*, 6th ed.,
+//! - \[Incropera\] F. P. Incropera et al., *Fundamentals of Heat and Mass Transfer*, 6th ed.,
 //!   Table 1.1 (free convection of gases 2-25 W/(m^2 K), forced 25-250) and Table A.5
 //!   (engine oil at 300 K: 0.145 W/(m K), 1909 J/(kg K), 884 kg/m^3).
-//! - [SKF] SKF rolling bearings catalogue (2018): 71908 CD: d = 40, D = 62, B = 12 mm, contact
+//! - \[SKF\] SKF rolling bearings catalogue (2018): 71908 CD: d = 40, D = 62, B = 12 mm, contact
 //!   angle 15 deg (suffix CD; ACD is 25 deg); grease fill 25-35 % of the free space.
 //! - [Table 3] the seed paper's Table 3 (71908: 40 x 62 x 12 mm, balls 5.5 mm).
 
@@ -35,11 +35,11 @@ pub struct ThermalParams {
     pub ambient_temperature_k: f64,
 
     // ---- rotor (shaft) node, eq. 19 ------------------------------------------------------
-    /// Thermal conductivity of the rotor lambda_s (W/(m K)). Default 44.5, shaft steel [ASM].
+    /// Thermal conductivity of the rotor lambda_s (W/(m K)). Default 44.5, shaft steel \[ASM\].
     pub rotor_conductivity_w_m_k: f64,
-    /// Specific heat of the rotor C_ps (J/(kg K)). Default 475, steel [ASM].
+    /// Specific heat of the rotor C_ps (J/(kg K)). Default 475, steel \[ASM\].
     pub rotor_specific_heat_j_kg_k: f64,
-    /// Density of the rotor (kg/m^3). Default 7850, steel [ASM].
+    /// Density of the rotor (kg/m^3). Default 7850, steel \[ASM\].
     pub rotor_density_kg_m3: f64,
     /// Length L_s of the journal section lumped into the rotor node, also the conduction length
     /// of R_sac in Table 1 (m). Not in the paper: default 50 mm, about four bearing widths of
@@ -52,16 +52,16 @@ pub struct ThermalParams {
 
     // ---- bearing steel (races and balls), eqs. 20-24, 26-28 -------------------------------
     /// Conductivity of races and balls lambda_i = lambda_e = lambda_b (W/(m K)). Default 46.6,
-    /// AISI 52100 [ASM].
+    /// AISI 52100 \[ASM\].
     pub bearing_conductivity_w_m_k: f64,
-    /// Specific heat of races and balls (J/(kg K)). Default 475, AISI 52100 [ASM].
+    /// Specific heat of races and balls (J/(kg K)). Default 475, AISI 52100 \[ASM\].
     pub bearing_specific_heat_j_kg_k: f64,
-    /// Density of the balls (kg/m^3), for their mass. Default 7810, AISI 52100 [ASM].
+    /// Density of the balls (kg/m^3), for their mass. Default 7810, AISI 52100 \[ASM\].
     pub bearing_density_kg_m3: f64,
     /// Linear expansion coefficient xi of races and balls (1/K), eqs. 26-28. Default 11.9e-6,
-    /// AISI 52100, 20-100 C [ASM].
+    /// AISI 52100, 20-100 C \[ASM\].
     pub bearing_expansion_per_k: f64,
-    /// Poisson's ratio nu of the races, eqs. 26-27. Default 0.3, bearing steel [Harris].
+    /// Poisson's ratio nu of the races, eqs. 26-27. Default 0.3, bearing steel \[Harris\].
     /// Allowed [0, 0.5).
     pub bearing_poisson_ratio: f64,
 
@@ -82,7 +82,7 @@ pub struct ThermalParams {
     /// between D = 62 mm and the raceway diameter over B (48 g) plus shoulders, in the
     /// proportion Table 2's inner race (0.048 kg) bears to its own annulus.
     pub outer_race_mass_kg: f64,
-    /// Initial contact angle alpha_0 of eq. 29 (deg). Default 15, the 71908 CD [SKF].
+    /// Initial contact angle alpha_0 of eq. 29 (deg). Default 15, the 71908 CD \[SKF\].
     /// Allowed [0, 90).
     pub contact_angle_deg: f64,
 
@@ -93,7 +93,7 @@ pub struct ThermalParams {
     /// Lubricant specific heat C_pL (J/(kg K)). Default 1909 [Incropera Table A.5].
     pub lubricant_specific_heat_j_kg_k: f64,
     /// Lubricant mass of each lubricant node m_Li = m_Le (kg). Default 1 g: a 30 % grease
-    /// fill [SKF] of the 71908's free space (about 7 cm^3), split between the two contacts.
+    /// fill \[SKF\] of the 71908's free space (about 7 cm^3), split between the two contacts.
     pub lubricant_mass_kg: f64,
     /// Convection coefficient h_l from the ball set and lubricant to the air (W/(m^2 K)),
     /// R_La in Table 1. Default 20 [Incropera Table 1.1]. Allowed [0, 1e5].
@@ -105,11 +105,11 @@ pub struct ThermalParams {
     pub housing_outer_radius_m: f64,
     /// Housing length L_h (m). Default 24 mm: the two face-to-face 71908 of one location.
     pub housing_length_m: f64,
-    /// Housing conductivity lambda_h (W/(m K)). Default 44.5, steel [ASM].
+    /// Housing conductivity lambda_h (W/(m K)). Default 44.5, steel \[ASM\].
     pub housing_conductivity_w_m_k: f64,
-    /// Housing specific heat C_ph (J/(kg K)). Default 475, steel [ASM].
+    /// Housing specific heat C_ph (J/(kg K)). Default 475, steel \[ASM\].
     pub housing_specific_heat_j_kg_k: f64,
-    /// Housing density (kg/m^3), for its mass. Default 7850, steel [ASM].
+    /// Housing density (kg/m^3), for its mass. Default 7850, steel \[ASM\].
     pub housing_density_kg_m3: f64,
     /// Convection coefficient h_h of the housing surfaces (W/(m^2 K)), R_hav and R_hrv in
     /// Table 1. Default 10, free convection in air [Incropera Table 1.1]. Allowed [0, 1e5].
