@@ -242,7 +242,8 @@ impl Monitor {
     }
 
     fn track_peaks(&mut self, sys: &DropSystem, dense: &Dense<N>, ts: [f64; 3], s: [&Sample; 3]) {
-        let trackers: [(fn(&Sample) -> f64, usize); 3] = [
+        type Get = fn(&Sample) -> f64;
+        let trackers: [(Get, usize); 3] = [
             (|x| x.normal, 0),
             (|x| x.friction_power, 1),
             (|x| x.heat_power, 2),

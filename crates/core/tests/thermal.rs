@@ -1,5 +1,6 @@
 //! The thermal model (paper Secs. 2.3 and 3, eqs. 14-31) checked against closed forms,
 //! hand-solved networks, conservation and the fully coupled reference.
+#![allow(clippy::type_complexity)] // tables of (setter, field name) cases
 
 use whirlmap_core::model::drag::{direction, Palmgren};
 use whirlmap_core::model::{ix, DropSystem, Mode, Slip};
