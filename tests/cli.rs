@@ -1,21 +1,8 @@
 //! End-to-end tests of the `whirlmap` binary: the JSON contract, bad input, scene files and
 //! charts.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn whirlmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whirlmap"))
-        .args(args)
-        .output()
-        .expect("runs the binary")
-}
-
-fn temp_path(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("whirlmap-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
+mod common;
+use common::*;
 
 #[test]
 fn json_output_parses_and_carries_every_contract_field() {

@@ -1,14 +1,8 @@
 //! End-to-end tests of `whirlmap critical`: a real search on the default scene, and bad
 //! input rejected with exit code 2 before any drop runs.
 
-use std::process::{Command, Output};
-
-fn whirlmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whirlmap"))
-        .args(args)
-        .output()
-        .expect("runs the binary")
-}
+mod common;
+use common::*;
 
 #[test]
 fn default_scene_at_mu_0_4_has_a_narrow_backward_whirl_bracket() {

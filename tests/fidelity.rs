@@ -1,13 +1,7 @@
 //! End-to-end tests of the fidelity presets and the `accuracy` command.
 
-use std::process::{Command, Output};
-
-fn whirlmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whirlmap"))
-        .args(args)
-        .output()
-        .expect("runs the binary")
-}
+mod common;
+use common::*;
 
 fn record(args: &[&str]) -> serde_json::Value {
     let out = whirlmap(args);

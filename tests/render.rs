@@ -1,21 +1,10 @@
 //! `whirlmap render DIR`: exit codes and the files it prints.
 
+mod common;
+use common::*;
+
 use std::path::PathBuf;
 use std::process::Command;
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("whirlmap-render-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn whirlmap(args: &[&std::ffi::OsStr]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_whirlmap"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 #[test]
 fn render_draws_charts_and_reports_exit_codes() {

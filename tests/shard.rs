@@ -2,11 +2,12 @@
 //! result equals the single-machine run byte for byte; the merge refuses missing, duplicated
 //! and mismatched shards and names what is missing; a killed shard resumes.
 
+mod common;
+use common::*;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-
-const BIN: &str = env!("CARGO_BIN_EXE_whirlmap");
 
 /// 9 grid points, 3 critical searches, 2 orbit panels, every chart: with 4 shards the parts
 /// are uneven (3, 2, 2, 2 points) and shard 3 owns no critical search and no orbit.
@@ -18,28 +19,6 @@ const SPEC: &str = r#"{
   "orbits": {"speed_rpm": 8000, "mu": [0.1, 0.4]},
   "charts": ["orbits", "critical", "max_force", "peak_power", "classes"]
 }"#;
-
-fn whirlmap(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("runs the binary")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("whirlmap-shard-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn write_spec(dir: &Path, text: &str) -> PathBuf {
     let p = dir.join("spec.json");

@@ -1,37 +1,17 @@
 //! End-to-end tests of `whirlmap sweep`: spec errors, determinism across thread counts,
 //! crash-safe resume, and failed points recorded as data.
 
+mod common;
+use common::*;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const BIN: &str = env!("CARGO_BIN_EXE_whirlmap");
-
-fn whirlmap(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("runs the binary")
-}
-
 /// A fresh temporary folder for one test.
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("whirlmap-sweep-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn smoke_spec() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/smoke.json")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn lines(path: &Path) -> Vec<serde_json::Value> {

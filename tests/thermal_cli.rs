@@ -2,21 +2,8 @@
 //! fields appear exactly when the thermal model is on, the temperature chart is written, and
 //! bad thermal input is exit 2 with the field named.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn whirlmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whirlmap"))
-        .args(args)
-        .output()
-        .expect("runs the binary")
-}
-
-fn temp_path(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("whirlmap-thermal-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
+mod common;
+use common::*;
 
 fn record(extra: &[&str]) -> serde_json::Value {
     let mut args = vec!["drop", "--duration-s", "0.05", "--json"];
