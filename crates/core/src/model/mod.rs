@@ -170,8 +170,8 @@ struct ForceCache {
 
 #[derive(Debug, Clone, Copy, Default)]
 struct CacheEntry {
-    valid: bool,
     y: [f64; N],
+    /// `None` while the slot is empty.
     mode: Option<Mode>,
     thermal_load_n: f64,
     forces: Forces,
@@ -180,13 +180,12 @@ struct CacheEntry {
 impl CacheEntry {
     #[inline]
     fn matches(&self, y: &[f64; N], mode: Mode, thermal_load_n: f64) -> bool {
-        self.valid
+        self.mode == Some(mode)
             && self
                 .y
                 .iter()
                 .zip(y)
                 .all(|(a, b)| a.to_bits() == b.to_bits())
-            && self.mode == Some(mode)
             && self.thermal_load_n.to_bits() == thermal_load_n.to_bits()
     }
 }
@@ -363,7 +362,6 @@ impl DropSystem {
         c.misses += 1;
         let e = &mut c.slots[i];
         e.forces = self.forces_in(y, mode);
-        e.valid = true;
         e.y = *y;
         e.mode = Some(mode);
         e.thermal_load_n = load;
