@@ -349,28 +349,44 @@ impl DropSystem {
     /// All forces, powers and accelerations at `y` in the current mode (memoised: the last
     /// two distinct requests are answered without recomputation, bit-identically).
     pub fn forces(&self, y: &[f64; N]) -> Forces {
+        self.with_forces(y, |f| *f)
+    }
+
+    /// Runs `op` on [`DropSystem::forces`] at `y` without copying the whole [`Forces`] out
+    /// of the memo (the right-hand side and the guards read a few fields of it).
+    #[inline]
+    pub fn with_forces<R>(&self, y: &[f64; N], op: impl FnOnce(&Forces) -> R) -> R {
         let (mode, load) = (self.mode, self.thermal_load_n);
         let mut c = self.cache.borrow_mut();
         for i in 0..2 {
             if c.slots[i].matches(y, mode, load) {
                 c.hits += 1;
-                return c.slots[i].forces;
+                return op(&c.slots[i].forces);
             }
         }
         let i = c.next;
         c.next = 1 - i;
         c.misses += 1;
         let e = &mut c.slots[i];
-        e.forces = self.forces_in(y, mode);
+        self.fill_forces(y, mode, &mut e.forces);
         e.y = *y;
         e.mode = Some(mode);
         e.thermal_load_n = load;
-        e.forces
+        op(&e.forces)
     }
 
     /// All forces, powers and accelerations at `y` in mode `mode`.
     pub fn forces_in(&self, y: &[f64; N], mode: Mode) -> Forces {
         let mut f = Forces::default();
+        self.fill_forces(y, mode, &mut f);
+        f
+    }
+
+    /// [`DropSystem::forces_in`], written into `out` (the memo's slot) instead of returned:
+    /// a returned [`Forces`] is copied once more on the way.
+    fn fill_forces(&self, y: &[f64; N], mode: Mode, out: &mut Forces) {
+        *out = Forces::default();
+        let f = out;
         let dx = y[ix::XR] - y[ix::XB];
         let dy = y[ix::YR] - y[ix::YB];
         let dist = (dx * dx + dy * dy).sqrt();
@@ -473,8 +489,7 @@ impl DropSystem {
         } else {
             0.0
         };
-        f.acc = self.accelerations(y, &f, ft, support_vec);
-        f
+        f.acc = self.accelerations(y, f, ft, support_vec);
     }
 
     /// The friction mode to enter at a state in contact, per eqs. 9-10: slip along the slip
@@ -537,35 +552,10 @@ impl DropSystem {
         self.f_ref
     }
 
-    /// Contact guard: `min(delta / s, F_raw / F_ref)`, positive exactly when eq. 7's force
-    /// is active (penetrating, and the damper not pulling). Continuous in the state.
+    /// The guards of [`OdeSystem::guards`] from the forces at the state.
     #[inline]
-    fn contact_indicator(&self, f: &Forces) -> f64 {
-        (f.delta_m / self.s).min(f.normal_raw_n / self.f_ref)
-    }
-}
-
-impl OdeSystem<N> for DropSystem {
-    fn rhs(&self, _t: f64, y: &[f64; N], dy: &mut [f64; N]) {
-        let f = self.forces(y);
-        dy[ix::XR] = y[ix::VXR];
-        dy[ix::YR] = y[ix::VYR];
-        dy[ix::TR] = y[ix::WR];
-        dy[ix::XB] = y[ix::VXB];
-        dy[ix::YB] = y[ix::VYB];
-        dy[ix::TB] = y[ix::WB];
-        dy[ix::VXR..=ix::WB].copy_from_slice(&f.acc);
-        dy[ix::E_FRIC] = f.friction_power_w;
-        dy[ix::E_DAMP] = f.damping_power_w;
-        dy[ix::E_DRAG] = f.bearing_power_w;
-    }
-
-    /// Guards: 0 contact (onset when free, loss when in contact), 1 support (release or
-    /// re-seat), 2 friction (slip velocity reversal while slipping; friction demand above
-    /// `mu_s F_n` while sticking).
-    fn guards(&self, _t: f64, y: &[f64; N], g: &mut [f64; MAX_GUARDS]) -> usize {
-        let f = self.forces(y);
-        let c = self.contact_indicator(&f);
+    fn guards_of(&self, f: &Forces, g: &mut [f64; MAX_GUARDS]) -> usize {
+        let c = self.contact_indicator(f);
         g[0] = if self.mode.contact { c } else { -c };
         let sup = f.support_raw_n / self.f_ref_b;
         g[1] = if self.mode.support { sup } else { -sup };
@@ -580,6 +570,37 @@ impl OdeSystem<N> for DropSystem {
         } else {
             2
         }
+    }
+
+    /// Contact guard: `min(delta / s, F_raw / F_ref)`, positive exactly when eq. 7's force
+    /// is active (penetrating, and the damper not pulling). Continuous in the state.
+    #[inline]
+    fn contact_indicator(&self, f: &Forces) -> f64 {
+        (f.delta_m / self.s).min(f.normal_raw_n / self.f_ref)
+    }
+}
+
+impl OdeSystem<N> for DropSystem {
+    fn rhs(&self, _t: f64, y: &[f64; N], dy: &mut [f64; N]) {
+        dy[ix::XR] = y[ix::VXR];
+        dy[ix::YR] = y[ix::VYR];
+        dy[ix::TR] = y[ix::WR];
+        dy[ix::XB] = y[ix::VXB];
+        dy[ix::YB] = y[ix::VYB];
+        dy[ix::TB] = y[ix::WB];
+        self.with_forces(y, |f| {
+            dy[ix::VXR..=ix::WB].copy_from_slice(&f.acc);
+            dy[ix::E_FRIC] = f.friction_power_w;
+            dy[ix::E_DAMP] = f.damping_power_w;
+            dy[ix::E_DRAG] = f.bearing_power_w;
+        });
+    }
+
+    /// Guards: 0 contact (onset when free, loss when in contact), 1 support (release or
+    /// re-seat), 2 friction (slip velocity reversal while slipping; friction demand above
+    /// `mu_s F_n` while sticking).
+    fn guards(&self, _t: f64, y: &[f64; N], g: &mut [f64; MAX_GUARDS]) -> usize {
+        self.with_forces(y, |f| self.guards_of(f, g))
     }
 
     /// The stiff part of the Jacobian for the linearly implicit stepper: the two Hertz

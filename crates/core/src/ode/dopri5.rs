@@ -148,6 +148,15 @@ pub(super) fn initial_step<const N: usize>(
 pub struct Dopri5<const N: usize> {
     core: StepCore<N>,
     k1: [f64; N],
+    /// The last trial step, written in place (returning it copied 720 bytes per attempt).
+    trial: Trial<N>,
+}
+
+/// One trial step's results: the 5th-order solution and the stages k3-k7 (k7 = f(y_new)).
+#[derive(Debug, Clone)]
+struct Trial<const N: usize> {
+    y_new: [f64; N],
+    k: [[f64; N]; 5],
 }
 
 /// Hairer's PI controller for DOPRI5: safety 0.9, beta 0.04, step ratio in [1/5, 10].
@@ -165,20 +174,20 @@ impl<const N: usize> Dopri5<N> {
         Self {
             core: StepCore::new(ctl, 5),
             k1: [0.0; N],
+            trial: Trial {
+                y_new: [0.0; N],
+                k: [[0.0; N]; 5],
+            },
         }
     }
 
     /// Builds the dense output of an accepted step and keeps k7 as the next k1 (FSAL).
-    fn accept(
-        &mut self,
-        t: f64,
-        y: &[f64; N],
-        h: f64,
-        y_new: &[f64; N],
-        k7: &[f64; N],
-        k: &[[f64; N]; 4],
-    ) {
-        let mut r = [[0.0; N]; 8];
+    fn accept(&mut self, t: f64, y: &[f64; N], h: f64) {
+        let (y_new, k) = (&self.trial.y_new, &self.trial.k);
+        let k7 = &k[4];
+        let d = &mut self.core.dense;
+        // Rows 5-7 of `r` stay unused (and zero) with `terms` 5.
+        let r = &mut d.r;
         for i in 0..N {
             let ydiff = y_new[i] - y[i];
             let bspl = h * self.k1[i] - ydiff;
@@ -194,34 +203,28 @@ impl<const N: usize> Dopri5<N> {
                     + D6 * k[3][i]
                     + D7 * k7[i]);
         }
-        self.core.dense = Dense {
-            t0: t,
-            h,
-            t_end: t + h,
-            terms: 5,
-            r,
-            y1: *y_new,
-        };
+        (d.t0, d.h, d.t_end, d.terms, d.y1) = (t, h, t + h, 5, *y_new);
         self.k1 = *k7;
         self.core.stats.steps += 1;
     }
 }
 
-/// One trial step from `(t, y)` with first stage `k1`: the 5th-order solution, the end
-/// derivative, stages 3-6, and the error norm (RMS of the embedded error over
-/// `atol + rtol * max(|y0|, |y1|)`).
-#[allow(clippy::type_complexity)]
+/// One trial step from `(t, y)` with first stage `k1`, written into `trial` (the 5th-order
+/// solution and stages 3-7, k7 the end derivative); returns the error norm (RMS of the
+/// embedded error over `atol + rtol * max(|y0|, |y1|)`).
 fn attempt<S: OdeSystem<N>, const N: usize>(
     core: &mut StepCore<N>,
     k1: &[f64; N],
+    trial: &mut Trial<N>,
     sys: &S,
     t: f64,
     y: &[f64; N],
     h: f64,
-) -> (([f64; N], [f64; N], [[f64; N]; 4]), f64) {
+) -> f64 {
     let mut yt = [0.0; N];
-    let (mut k2, mut k3, mut k4, mut k5, mut k6, mut k7) =
-        ([0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+    let mut k2 = [0.0; N];
+    let [k3, k4, k5, k6, k7] = &mut trial.k;
+    let y_new = &mut trial.y_new;
     for i in 0..N {
         yt[i] = y[i] + h * A21 * k1[i];
     }
@@ -229,24 +232,23 @@ fn attempt<S: OdeSystem<N>, const N: usize>(
     for i in 0..N {
         yt[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i]);
     }
-    sys.rhs(t + C3 * h, &yt, &mut k3);
+    sys.rhs(t + C3 * h, &yt, k3);
     for i in 0..N {
         yt[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
     }
-    sys.rhs(t + C4 * h, &yt, &mut k4);
+    sys.rhs(t + C4 * h, &yt, k4);
     for i in 0..N {
         yt[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
     }
-    sys.rhs(t + C5 * h, &yt, &mut k5);
+    sys.rhs(t + C5 * h, &yt, k5);
     for i in 0..N {
         yt[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
     }
-    sys.rhs(t + h, &yt, &mut k6);
-    let mut y_new = [0.0; N];
+    sys.rhs(t + h, &yt, k6);
     for i in 0..N {
         y_new[i] = y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
     }
-    sys.rhs(t + h, &y_new, &mut k7);
+    sys.rhs(t + h, y_new, k7);
     core.stats.rhs_evals += 6;
     let mut acc = 0.0;
     for i in 0..N {
@@ -254,8 +256,7 @@ fn attempt<S: OdeSystem<N>, const N: usize>(
         let sc = core.ctl.atol[i] + core.ctl.rtol * y[i].abs().max(y_new[i].abs());
         acc += (e / sc) * (e / sc);
     }
-    let err = (acc / N as f64).sqrt();
-    ((y_new, k7, [k3, k4, k5, k6]), err)
+    (acc / N as f64).sqrt()
 }
 
 impl<const N: usize> Stepper<N> for Dopri5<N> {
@@ -270,11 +271,11 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError> {
-        let k1 = &self.k1;
-        let ((y_new, k7, k), h) = self
-            .core
-            .control(&LAW, t, h_cap, |core, h| attempt(core, k1, sys, t, y, h))?;
-        self.accept(t, y, h, &y_new, &k7, &k);
+        let (k1, trial) = (&self.k1, &mut self.trial);
+        let ((), h) = self.core.control(&LAW, t, h_cap, |core, h| {
+            ((), attempt(core, k1, trial, sys, t, y, h))
+        })?;
+        self.accept(t, y, h);
         Ok(&self.core.dense)
     }
     fn core(&self) -> &StepCore<N> {
