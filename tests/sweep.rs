@@ -8,8 +8,6 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// A fresh temporary folder for one test.
-
 fn smoke_spec() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/smoke.json")
 }

@@ -467,10 +467,10 @@ impl DropSystem {
                 (FrictionLaw::Switched, Slip::Slipping(sign)) => self.mu_d * f.normal_n * sign,
                 (FrictionLaw::Switched, Slip::Sticking) => {
                     // v_rel' is affine in F_t: solve v_rel' = 0.
-                    let a0 = self.accelerations(y, &f, 0.0, support_vec);
-                    let a1 = self.accelerations(y, &f, 1.0, support_vec);
-                    let s0 = self.slip_acceleration(&f, v_t, &a0);
-                    let s1 = self.slip_acceleration(&f, v_t, &a1);
+                    let a0 = self.accelerations(y, f, 0.0, support_vec);
+                    let a1 = self.accelerations(y, f, 1.0, support_vec);
+                    let s0 = self.slip_acceleration(f, v_t, &a0);
+                    let s1 = self.slip_acceleration(f, v_t, &a1);
                     -s0 / (s1 - s0)
                 }
             }
