@@ -137,12 +137,11 @@ struct Sample {
 }
 
 fn sample(sys: &DropSystem, y: &[f64; N]) -> Sample {
-    let f = sys.forces(y);
-    Sample {
+    sys.with_forces(y, |f| Sample {
         normal: f.normal_n,
         friction_power: f.friction_power_w,
         heat_power: f.friction_power_w + f.bearing_power_w,
-    }
+    })
 }
 
 /// Locates the maximum of `q` on `[a, b]` by golden-section search on the interpolant.
