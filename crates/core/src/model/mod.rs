@@ -353,7 +353,8 @@ impl DropSystem {
     }
 
     /// Runs `op` on [`DropSystem::forces`] at `y` without copying the whole [`Forces`] out
-    /// of the memo (the right-hand side and the guards read a few fields of it).
+    /// of the memo (the right-hand side and the guards read a few fields of it). The memo
+    /// stays borrowed while `op` runs, so `op` must not evaluate this system again.
     #[inline]
     pub fn with_forces<R>(&self, y: &[f64; N], op: impl FnOnce(&Forces) -> R) -> R {
         let (mode, load) = (self.mode, self.thermal_load_n);
