@@ -365,7 +365,7 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
         sys.rhs(t + h, &y1, &mut f1);
         self.core.stats.rhs_evals += 1;
         // Cubic Hermite in DOPRI5's nested form with the 4th coefficient zero, written in
-        // place (rows 5-7 stay unused with `terms` 5).
+        // place (row 4 stays zero from `StepCore::new`, rows 5-7 unused with `terms` 5).
         let d = &mut self.core.dense;
         let r = &mut d.r;
         for i in 0..N {
@@ -375,7 +375,6 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
             r[1][i] = ydiff;
             r[2][i] = bspl;
             r[3][i] = ydiff - h * f1[i] - bspl;
-            r[4][i] = 0.0;
         }
         (d.t0, d.h, d.t_end, d.terms, d.y1) = (t, h, t + h, 5, y1);
         self.f0 = f1;
