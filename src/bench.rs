@@ -37,12 +37,12 @@ const RUNAWAY_SCENE: &str = include_str!("../scenes/runaway.json");
 /// How a bench row departs from the default scene.
 #[derive(Clone, Copy)]
 enum Numerics {
-    /// The scene's defaults (DOPRI5, rtol 1e-5, radial support damper).
+    /// The scene's defaults (DOPRI5, rtol 1e-5, isotropic support damper).
     Default,
-    /// The isotropic support damper, default numerics.
-    Iso,
-    /// ROS34PW2 with the gap bound at `rtol`; with `race`, also the isotropic support damper
-    /// and that factor on the race's absolute tolerances.
+    /// The paper's radial-only support damper, default numerics.
+    Radial,
+    /// ROS34PW2 with the gap bound at `rtol`; with `race`, also that factor on the race's
+    /// absolute tolerances.
     Ros { rtol: f64, race: Option<f64> },
 }
 
@@ -70,9 +70,9 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         "model evals/step"
     );
     // Then the linearly implicit ROS34PW2 with the free-flight gap bound (README, "Speed
-    // against accuracy") at two tolerances, and the isotropic support damper
-    // (`support_damping_isotropic`, a model choice) with DOPRI5 and with ROS34PW2, the gap
-    // bound and the race's absolute tolerances x1000 (`solver.race_atol_scale`).
+    // against accuracy") at two tolerances, the paper's radial-only support damper
+    // (`support_damper = radial_only`) with DOPRI5, and ROS34PW2 with the gap bound and the
+    // race's absolute tolerances x1000 (`solver.race_atol_scale`).
     let plain = Numerics::Default;
     let ros = |rtol| Numerics::Ros { rtol, race: None };
     let iso_ros = |rtol| Numerics::Ros {
@@ -112,42 +112,42 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             ros(1e-5),
         ),
         (
-            "iso: pendulum, dopri5 rtol 1e-5",
+            "radial: pendulum, dopri5 rtol 1e-5",
             8000.0,
             0.1,
             false,
-            Numerics::Iso,
+            Numerics::Radial,
         ),
         (
-            "iso: whirl, dopri5 rtol 1e-5",
+            "radial: whirl, dopri5 rtol 1e-5",
             8000.0,
             0.4,
             false,
-            Numerics::Iso,
+            Numerics::Radial,
         ),
         (
-            "iso: pendulum, ros+race x1000 1e-4",
+            "pendulum, ros+race x1000 1e-4",
             8000.0,
             0.1,
             false,
             iso_ros(1e-4),
         ),
         (
-            "iso: whirl, ros+race x1000 1e-4",
+            "whirl, ros+race x1000 1e-4",
             8000.0,
             0.4,
             false,
             iso_ros(1e-4),
         ),
         (
-            "iso: pendulum, ros+race x1000 1e-5",
+            "pendulum, ros+race x1000 1e-5",
             8000.0,
             0.1,
             false,
             iso_ros(1e-5),
         ),
         (
-            "iso: whirl, ros+race x1000 1e-5",
+            "whirl, ros+race x1000 1e-5",
             8000.0,
             0.4,
             false,
@@ -160,13 +160,12 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         scene.mu_dynamic = mu;
         match numerics {
             Numerics::Default => {}
-            Numerics::Iso => scene.support_damping_isotropic = true,
+            Numerics::Radial => scene.support_damper = whirlmap_core::SupportDamper::RadialOnly,
             Numerics::Ros { rtol, race } => {
                 scene.solver.method = whirlmap_core::Method::Ros34pw2;
                 scene.solver.free_flight_gap_bound = true;
                 scene.solver.rtol = rtol;
                 if let Some(f) = race {
-                    scene.support_damping_isotropic = true;
                     scene.solver.race_atol_scale = f;
                 }
             }
@@ -234,7 +233,7 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
 /// accepted step, computed + reused (the stepper's stages, the guards, the monitor; reused
 /// ones are served by `DropSystem`'s memo of the step end and midpoint).
 fn print_row(name: &str, wall_ms: f64, r: &DropReport, evals: ModelEvals) {
-    let note = if r.stop_reason == StopReason::WhirlTurnsReached {
+    let note = if r.stop_reason == StopReason::WhirlDecided {
         " (whirl decided)"
     } else {
         ""

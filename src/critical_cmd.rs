@@ -1,18 +1,20 @@
-//! `whirlmap critical`: the critical backward-whirl speed for each friction coefficient.
+//! `whirlmap critical`: the onset of sustained backward whirl and every whirl interval, for
+//! each friction coefficient.
 //!
-//! Exit codes as the rest of the tool: 2 for bad input (validated before any drop runs).
-//! Failed drops do not fail the command: they are reported in each result.
+//! `--json` prints the same rows a sweep writes to `critical.json` (a list of
+//! [`CriticalRow`]); `--csv FILE` also writes them as `critical.csv` does. Exit codes as the
+//! rest of the tool: 2 for bad input (validated before any drop runs). Failed drops do not
+//! fail the command: they are reported in each row.
 
 use crate::{build_scene, Failure};
-use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
-use whirlmap_core::{InvalidParameter, MODEL_VERSION};
-use whirlmap_sweep::classify::{ClassifyParams, OrbitClass};
+use whirlmap_core::InvalidParameter;
 use whirlmap_sweep::critical::{
-    check_mus, critical_speeds_with, CriticalOptions, CriticalResult, DEFAULT_SCAN_POINTS,
+    check_mus, critical_rows, csv_text, fmt_rpm, CriticalOptions, CriticalRow,
+    DEFAULT_RESOLUTION_RPM, DEFAULT_TOL_RPM,
 };
-use whirlmap_sweep::recheck::{recheck_bracket, Recheck};
+use whirlmap_sweep::recheck::recheck_bracket;
 
 #[derive(clap::Args)]
 pub struct CriticalArgs {
@@ -24,19 +26,22 @@ pub struct CriticalArgs {
         allow_negative_numbers = true
     )]
     mu: Vec<f64>,
-    /// Lowest release speed searched (r/min), >= 0.
-    #[arg(long, allow_negative_numbers = true)]
+    /// Lowest release speed searched (r/min), in [0, 1e6).
+    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
     from: f64,
-    /// Highest release speed searched (r/min), > --from.
-    #[arg(long, allow_negative_numbers = true)]
+    /// Highest release speed searched (r/min), in (--from, 1e6].
+    #[arg(long, default_value_t = 30000.0, allow_negative_numbers = true)]
     to: f64,
-    /// Stop bisecting when the bracket is this narrow (r/min), > 0.
-    #[arg(long, default_value_t = 50.0, allow_negative_numbers = true)]
+    /// Lattice step of the scan (r/min): every multiple of it in the range is dropped,
+    /// whatever the range ends, so the onset does not depend on the range.
+    #[arg(long, default_value_t = DEFAULT_RESOLUTION_RPM, allow_negative_numbers = true)]
+    resolution_rpm: f64,
+    /// Bisect every transition until its bracket is this narrow (r/min), at most the
+    /// resolution.
+    #[arg(long, default_value_t = DEFAULT_TOL_RPM, allow_negative_numbers = true)]
     tol_rpm: f64,
-    /// Points of the coarse scan over [--from, --to], >= 2.
-    #[arg(long, default_value_t = DEFAULT_SCAN_POINTS)]
-    scan_points: usize,
-    /// Simulated time of each drop (s).
+    /// Simulated time of each drop (s); a drop whose class has not settled by then is
+    /// extended (scene `classification.max_extension_s`).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     duration_s: f64,
     /// Scene file (JSON); any subset of the fields printed by `whirlmap scene`.
@@ -45,35 +50,16 @@ pub struct CriticalArgs {
     /// Override one scene parameter, e.g. `--set clearance_m=2e-4`.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
-    /// Print the results as JSON instead of tables.
+    /// Print the rows as JSON (the schema of a sweep's critical.json) instead of a table.
     #[arg(long)]
     json: bool,
-    /// Fidelity preset (draft, standard, reference) for the search; the two bracket cells
-    /// are then re-checked at the next tighter preset (recorded as `recheck`).
+    /// Also write the rows as CSV (the columns of a sweep's critical.csv) to this file.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Fidelity preset (draft, standard, reference) for the search; the onset bracket is
+    /// then re-checked at the next tighter preset (recorded as `recheck`).
     #[arg(long)]
     fidelity: Option<whirlmap_core::Fidelity>,
-}
-
-/// The JSON output: the search settings and one result per mu.
-#[derive(Serialize)]
-struct Output<'a> {
-    from_rpm: f64,
-    to_rpm: f64,
-    tol_rpm: f64,
-    scan_points: usize,
-    duration_s: f64,
-    scene_hash: String,
-    model_version: u32,
-    results: Vec<MuResult<'a>>,
-}
-
-#[derive(Serialize)]
-struct MuResult<'a> {
-    mu: f64,
-    #[serde(flatten)]
-    result: &'a CriticalResult,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    recheck: Option<Recheck>,
 }
 
 /// Names a bad flag: `--from = -5: allowed ...`.
@@ -82,7 +68,7 @@ fn flag_error(e: InvalidParameter) -> Failure {
         "from_rpm" => "--from",
         "to_rpm" => "--to",
         "tol_rpm" => "--tol-rpm",
-        "scan_points" => "--scan-points",
+        "resolution_rpm" => "--resolution-rpm",
         "duration_s" => "--duration-s",
         "mu" => "--mu",
         other => other,
@@ -98,10 +84,9 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
     let opts = CriticalOptions {
         from_rpm: a.from,
         to_rpm: a.to,
+        resolution_rpm: a.resolution_rpm,
         tol_rpm: a.tol_rpm,
-        scan_points: a.scan_points,
         duration_s: a.duration_s,
-        classify: ClassifyParams::default(),
     };
     opts.validate().map_err(flag_error)?;
     check_mus(&a.mu).map_err(flag_error)?;
@@ -116,97 +101,110 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
         s.validate()
             .map_err(|e| Failure::Input(anyhow::anyhow!("with --mu {mu}: {e}")))?;
     }
+    if let Some(p) = &a.csv {
+        crate::check_writable(p).map_err(Failure::Output)?;
+    }
 
     let start = Instant::now();
-    let results = critical_speeds_with(&base, &a.mu, &opts);
-    let drop_opts = whirlmap_core::DropOptions {
-        duration_s: a.duration_s,
-        ..Default::default()
-    };
-    let rechecks: Vec<Option<Recheck>> = results
-        .iter()
-        .map(|(mu, r)| {
-            let tighter = a.fidelity.and_then(|f| f.tighter())?;
+    let mut rows = critical_rows(&base, &a.mu, &opts).map_err(|e| Failure::Input(e.into()))?;
+    if let Some(tighter) = a.fidelity.and_then(|f| f.tighter()) {
+        let drop_opts = whirlmap_core::DropOptions {
+            duration_s: a.duration_s,
+            ..Default::default()
+        };
+        for row in rows.iter_mut() {
             let mut s = base.clone();
-            s.mu_dynamic = *mu;
-            recheck_bracket(&s, r, tighter, &drop_opts, &ClassifyParams::default())
-        })
-        .collect();
+            s.mu_dynamic = row.mu;
+            row.recheck = recheck_bracket(&s, row, tighter, &drop_opts);
+        }
+    }
     let wall_s = start.elapsed().as_secs_f64();
+    if let Some(p) = &a.csv {
+        std::fs::write(p, csv_text(&rows))
+            .map_err(|e| Failure::Output(anyhow::anyhow!("cannot write {}: {e}", p.display())))?;
+    }
 
     if a.json {
-        let out = Output {
-            from_rpm: a.from,
-            to_rpm: a.to,
-            tol_rpm: a.tol_rpm,
-            scan_points: a.scan_points,
-            duration_s: a.duration_s,
-            scene_hash: base.hash_hex(),
-            model_version: MODEL_VERSION,
-            results: results
-                .iter()
-                .zip(&rechecks)
-                .map(|((mu, result), recheck)| MuResult {
-                    mu: *mu,
-                    result,
-                    recheck: recheck.clone(),
-                })
-                .collect(),
-        };
         println!(
             "{}",
-            serde_json::to_string_pretty(&out).expect("results serialise")
+            serde_json::to_string_pretty(&rows).expect("results serialise")
         );
         return Ok(());
     }
+    print_table(a, &rows, wall_s);
+    Ok(())
+}
 
+fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
     println!(
-        "whirlmap critical: {}-{} r/min, {} scan points, tolerance {} r/min, {} s per drop",
-        a.from, a.to, a.scan_points, a.tol_rpm, a.duration_s
+        "whirlmap critical: {}-{} r/min on a {} r/min lattice, bisected to {} r/min, {} s per drop",
+        fmt_rpm(a.from),
+        fmt_rpm(a.to),
+        fmt_rpm(a.resolution_rpm),
+        a.tol_rpm,
+        a.duration_s
     );
-    let class = |c: Option<OrbitClass>| c.map_or("-", |c| c.name());
-    for ((mu, r), recheck) in results.iter().zip(&rechecks) {
+    let class = |c: Option<whirlmap_sweep::classify::OrbitClass>| c.map_or("-", |c| c.name());
+    for r in rows {
         println!();
-        println!("  mu_d = {mu}");
-        match r.bracket {
-            Some((lo, hi)) => println!(
-                "    bracket (r/min)     {lo:.1} .. {hi:.1}  (width {:.1}{})",
-                hi - lo,
+        println!("  mu_d = {}", r.mu);
+        match (r.onset_rpm, r.bracket_rpm) {
+            (Some(o), Some([lo, hi])) => println!(
+                "    onset of whirl      {} r/min (bracket {}-{}{})",
+                fmt_rpm(o),
+                fmt_rpm(lo),
+                fmt_rpm(hi),
                 if r.converged { "" } else { ", NOT converged" }
             ),
-            None => println!("    bracket (r/min)     none"),
+            (Some(o), None) => println!(
+                "    onset of whirl      at or below {} r/min (whirl at the lowest speed)",
+                fmt_rpm(o)
+            ),
+            _ => println!("    onset of whirl      none in the range"),
         }
-        println!("    class below         {}", class(r.class_lo));
-        println!("    class above         {}", class(r.class_hi));
-        println!("    drops used          {}", r.drops_used);
         println!(
-            "    failed drops        {}",
-            if r.failures.is_empty() {
-                "0".to_string()
+            "    classes             {} below, {} above",
+            class(r.class_below),
+            class(r.class_above)
+        );
+        let intervals: Vec<String> = r
+            .whirl_intervals_rpm
+            .iter()
+            .map(|[x, y]| format!("{}-{}", fmt_rpm(*x), fmt_rpm(*y)))
+            .collect();
+        println!(
+            "    whirl intervals     {}{}",
+            if intervals.is_empty() {
+                "none".to_string()
             } else {
-                r.failures
-                    .iter()
-                    .map(|f| format!("{:.1} r/min ({})", f.speed_rpm, f.error))
-                    .collect::<Vec<_>>()
-                    .join("; ")
+                intervals.join(", ")
+            },
+            if r.whirl_at_range_top {
+                " (to the range top)"
+            } else {
+                ""
             }
         );
         println!(
             "    non-monotone        {}",
             if r.non_monotone { "YES" } else { "no" }
         );
+        println!(
+            "    drops               {} ({} failed)",
+            r.drops, r.failed_drops
+        );
         println!("    note                {}", r.note);
-        if let Some(rc) = recheck {
+        if let Some(rc) = &r.recheck {
             let show = |o: &whirlmap_sweep::critical::Outcome| match o {
                 whirlmap_sweep::critical::Outcome::Class(c) => c.name().to_string(),
                 whirlmap_sweep::critical::Outcome::Failed(e) => format!("failed ({e})"),
             };
             println!(
-                "    recheck ({})   {:.1}: {}, {:.1}: {} -> {}",
+                "    recheck ({})   {}: {}, {}: {} -> {}",
                 rc.fidelity,
-                rc.lo.0,
+                fmt_rpm(rc.lo.0),
                 show(&rc.lo.1),
-                rc.hi.0,
+                fmt_rpm(rc.hi.0),
                 show(&rc.hi.1),
                 if rc.confirmed {
                     "bracket confirmed"
@@ -216,9 +214,8 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
             );
         }
     }
-    let drops: usize = results.iter().map(|(_, r)| r.drops_used).sum::<usize>()
-        + 2 * rechecks.iter().flatten().count();
+    let drops: usize = rows.iter().map(|r| r.drops).sum::<usize>()
+        + 2 * rows.iter().filter(|r| r.recheck.is_some()).count();
     println!();
     println!("  {drops} drops, {wall_s:.2} s wall");
-    Ok(())
 }

@@ -10,7 +10,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 use whirlmap_core::{simulate, DropOptions, DropReport, Scene};
-use whirlmap_sweep::classify::ClassifyParams;
 use whirlmap_sweep::overrides::apply_assignment;
 use whirlmap_sweep::record::DropRecord;
 use whirlmap_sweep::render::{draw_orbit, ImageFormat};
@@ -129,6 +128,31 @@ impl Failure {
     }
 }
 
+/// Checks that `path` can be written before any simulation runs: its folder exists and a
+/// file can be created in it. The error names the path and the cause.
+pub(crate) fn check_writable(path: &Path) -> anyhow::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "cannot write {}: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    if path.is_dir() {
+        anyhow::bail!("cannot write {}: it is a folder", path.display());
+    }
+    let probe = dir.join(format!(".whirlmap-probe-{}", std::process::id()));
+    let created = std::fs::File::create(&probe);
+    let _ = std::fs::remove_file(&probe);
+    created
+        .map(|_| ())
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+}
+
 /// Default scene, then the scene file, then `--set`, then the explicit flags; validated.
 fn build_scene(
     file: Option<&Path>,
@@ -193,7 +217,7 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
     let report = simulate(&scene, &opts)
         .map_err(|e| Failure::Solve(anyhow::anyhow!("simulation failed ({}): {e}", e.kind())))?;
     let wall_s = start.elapsed().as_secs_f64();
-    let record = DropRecord::from_report(&report, &ClassifyParams::default());
+    let record = DropRecord::from_report(&report);
     if let (Some(path), Some(orbit)) = (&a.orbit, &report.orbit) {
         let title = format!(
             "{:.0} r/min, mu = {:.2}: {}",
@@ -232,14 +256,26 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
     let e = &r.energy;
     let why = match r.stop_reason {
         whirlmap_core::StopReason::DurationReached => "duration reached",
-        whirlmap_core::StopReason::WhirlTurnsReached => "stopped: whirl decided",
+        whirlmap_core::StopReason::WhirlDecided => "stopped: whirl decided",
         whirlmap_core::StopReason::StopSpeedReached => "stopped: stop speed reached",
     };
+    let extended = if r.extension_s > 0.0 {
+        format!(
+            ", extended by {:.3} s for the class to settle",
+            r.extension_s
+        )
+    } else {
+        String::new()
+    };
     println!(
-        "whirlmap drop: {:.0} r/min, mu_d {:.3}, {:.4} s simulated ({why})",
+        "whirlmap drop: {:.0} r/min, mu_d {:.3}, {:.4} s simulated ({why}{extended})",
         scene.speed_rpm, scene.mu_dynamic, r.end_time_s
     );
-    println!("  class                 {}", rec.class.label());
+    println!(
+        "  class                 {} ({})",
+        rec.class.label(),
+        rec.class_reason.describe()
+    );
     println!("  first contact force   {:.1} N", f.first_contact_force_n);
     println!(
         "  max contact force     {:.1} N (at {:.2} ms)",
@@ -249,12 +285,23 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
     println!("  peak friction power   {:.1} W", f.peak_friction_power_w);
     println!("  peak heat power       {:.1} W", f.peak_heat_power_w);
     println!(
-        "  whirl frequency       {:+.2} Hz (net turns {:+.2}; negative = against the spin)",
-        f.whirl_frequency_hz, f.net_whirl_turns
+        "  whirl frequency       {:+.2} Hz (negative = against the spin)",
+        f.whirl_frequency_hz
     );
     println!(
-        "  contact duty          {:.3} (window {:.3}-{:.3} s), {} impacts",
-        f.window.contact_duty, f.window.start_s, f.window.end_s, f.impacts
+        "  contact point turns   {:+.2} since first touch, {:+.2} before settling, {:+.0} consecutive carried at the end",
+        f.net_whirl_turns, f.transient_whirl_turns, f.whirl_streak_turns
+    );
+    let w = &f.window.stats;
+    println!(
+        "  final window          {:.3}-{:.3} s: contact duty {:.3}, mean angle {:+.1} deg from the bottom, range {:.1} deg, {:+.2} turns; {} impacts in all",
+        w.start_s,
+        w.end_s,
+        w.contact_duty,
+        w.angle_mean_rad.to_degrees(),
+        w.angle_range_rad.to_degrees(),
+        w.net_turns,
+        f.impacts
     );
     println!(
         "  final speeds          rotor {:.0} r/min, race {:.0} r/min",

@@ -88,13 +88,17 @@ pub fn run(a: &SweepArgs) -> ExitCode {
         println!("  {class:<16} {n}");
     }
     println!("  output           {}", outcome.out_dir.display());
-    match whirlmap_sweep::extras::run_all(&spec, &outcome.out_dir, opts.threads) {
-        Ok((critical, orbits)) => {
-            if let Some(p) = critical {
+    let progress = !a.no_progress;
+    match whirlmap_sweep::extras::run_all(&spec, &outcome.out_dir, opts.threads, progress) {
+        Ok(x) => {
+            if let Some(p) = x.critical {
                 println!("  critical speeds  {}", p.display());
             }
-            if !orbits.is_empty() {
-                println!("  orbits           {} drops recorded", orbits.len());
+            if !x.orbits.is_empty() {
+                println!("  orbits           {} drops recorded", x.orbits.len());
+            }
+            if let Some(p) = x.probability {
+                println!("  probability      {}", p.display());
             }
         }
         Err(e) => {

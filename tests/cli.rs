@@ -14,6 +14,9 @@ fn json_output_parses_and_carries_every_contract_field() {
         "0.3",
         "--duration-s",
         "0.05",
+        // Exactly 0.05 s: the classifier's extension off.
+        "--set",
+        "classification.max_extension_s=0",
         "--json",
     ]);
     assert!(
@@ -24,6 +27,9 @@ fn json_output_parses_and_carries_every_contract_field() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
     for key in [
         "class",
+        "class_reason",
+        "transient_whirl_turns",
+        "extension_s",
         "first_contact_force_n",
         "max_contact_force_n",
         "peak_friction_power_w",
@@ -68,6 +74,45 @@ fn json_output_parses_and_carries_every_contract_field() {
     assert!((v["end_time_s"].as_f64().unwrap() - 0.05).abs() < 1e-12);
     assert!(v["first_contact_force_n"].as_f64().unwrap() > 500.0);
     assert_eq!(v["scene_hash"].as_str().unwrap().len(), 16);
+    // 0.05 s is too short for the final window to settle: said, not hidden.
+    assert_eq!(v["class"], "unresolved");
+    assert_eq!(v["extension_s"], 0.0);
+}
+
+#[test]
+fn a_drop_that_has_not_settled_is_extended_until_its_class_is_decided() {
+    let out = whirlmap(&[
+        "drop",
+        "--speed-rpm",
+        "8000",
+        "--mu",
+        "0.1",
+        "--duration-s",
+        "0.05",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+    assert_eq!(v["class"], "pendulum", "{v}");
+    assert_eq!(v["class_reason"], "settled_rocking");
+    let (end, ext) = (
+        v["end_time_s"].as_f64().unwrap(),
+        v["extension_s"].as_f64().unwrap(),
+    );
+    assert!(ext > 0.0 && (end - 0.05 - ext).abs() < 1e-12, "{end} {ext}");
+    // The human summary says so.
+    let out = whirlmap(&[
+        "drop",
+        "--speed-rpm",
+        "8000",
+        "--mu",
+        "0.1",
+        "--duration-s",
+        "0.05",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("extended by"), "{text}");
+    assert!(text.contains("pendulum vibration"), "{text}");
 }
 
 #[test]

@@ -87,10 +87,25 @@ fn compare_exit_codes_thresholds_and_report() {
     );
     assert_ne!(edited, first);
     std::fs::write(new.join("points.jsonl"), text.replacen(first, &edited, 1)).unwrap();
+    // Critical-speed rows in the schema of critical.json: the onset bracket [lo, hi] at
+    // mu 0.3, and a fixed one at mu 0.4.
+    let row = |mu: f64, lo: f64, hi: f64| {
+        whirlmap_sweep::critical::SearchResult {
+            onset_rpm: Some(hi),
+            bracket_rpm: Some([lo, hi]),
+            class_below: None,
+            class_above: None,
+            whirl_intervals_rpm: vec![[hi, 12000.0]],
+            whirl_at_range_top: true,
+            converged: true,
+            scan: Vec::new(),
+            bisections: Vec::new(),
+            note: String::new(),
+        }
+        .into_row(mu, &Default::default(), String::new())
+    };
     let critical = |lo: f64, hi: f64| {
-        format!(
-            r#"[{{"mu": 0.3, "result": {{"bracket": [{lo}, {hi}]}}}}, {{"mu": 0.4, "result": {{"bracket": [4000.0, 4100.0]}}}}]"#
-        )
+        serde_json::to_string(&[row(0.3, lo, hi), row(0.4, 4000.0, 4100.0)]).unwrap()
     };
     std::fs::write(base.join("critical.json"), critical(4000.0, 4500.0)).unwrap();
     std::fs::write(new.join("critical.json"), critical(4400.0, 4900.0)).unwrap();
@@ -114,7 +129,7 @@ fn compare_exit_codes_thresholds_and_report() {
     );
     assert!(
         md.contains(
-            "| 0.3 | 4000-4500 r/min | 4600-4900 r/min | moved up (brackets do not overlap) |"
+            "| 0.3 | 4000-4500 r/min | 4600-4900 r/min | onset moved up (brackets do not overlap) |"
         ),
         "{md}"
     );

@@ -4,41 +4,125 @@
 mod common;
 use common::*;
 
+/// Runs `whirlmap critical --json` and returns its rows.
+fn rows(args: &[&str]) -> Vec<serde_json::Value> {
+    let mut all = vec!["critical", "--json"];
+    all.extend_from_slice(args);
+    let out = whirlmap(&all);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{all:?}: {stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+    v.as_array().expect("a list of rows").clone()
+}
+
 #[test]
-fn default_scene_at_mu_0_4_has_a_narrow_backward_whirl_bracket() {
-    // About 13 drops, under a second in the optimised test profile.
-    let out = whirlmap(&[
-        "critical",
+fn default_scene_at_mu_0_4_has_an_onset_bracketed_within_the_tolerance() {
+    // 11 lattice drops of 0.5 s (whirl ones stop after about 60 ms) and 3 bisections.
+    let rows = rows(&[
         "--mu",
         "0.4",
         "--from",
         "2000",
         "--to",
         "12000",
+        "--resolution-rpm",
+        "1000",
         "--tol-rpm",
-        "500",
+        "125",
         "--duration-s",
         "0.5",
-        "--json",
     ]);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
-    let results = v["results"].as_array().expect("results array");
-    assert_eq!(results.len(), 1);
-    let r = &results[0];
+    assert_eq!(rows.len(), 1);
+    let r = &rows[0];
     assert_eq!(r["mu"], 0.4);
-    let bracket = r["bracket"].as_array().expect("a bracket exists");
-    let (lo, hi) = (bracket[0].as_f64().unwrap(), bracket[1].as_f64().unwrap());
-    assert!(2000.0 <= lo && lo < hi && hi <= 12000.0, "{lo} {hi}");
-    assert!(hi - lo <= 500.0, "{lo} {hi}");
-    assert_eq!(r["class_hi"], "backward_whirl");
+    let b = r["bracket_rpm"].as_array().expect("a bracket exists");
+    let (lo, hi) = (b[0].as_f64().unwrap(), b[1].as_f64().unwrap());
+    assert!(
+        2000.0 <= lo && lo < hi && hi <= 12000.0 && hi - lo <= 125.0,
+        "{lo} {hi}"
+    );
+    assert_eq!(r["onset_rpm"].as_f64(), Some(hi));
+    assert_eq!(r["class_above"], "backward_whirl");
+    assert_eq!(
+        r["class_below"], "pendulum",
+        "a settled class below, not unresolved"
+    );
     assert_eq!(r["converged"], true);
-    let drops = r["drops_used"].as_u64().unwrap();
-    assert!((12..=20).contains(&drops), "drops_used {drops}");
-    assert_eq!(r["scanned"].as_array().unwrap().len(), 12);
+    assert_eq!(r["non_monotone"], false);
+    let intervals = r["whirl_intervals_rpm"].as_array().unwrap();
+    assert_eq!(intervals.len(), 1);
+    assert_eq!(intervals[0][0].as_f64(), Some(hi));
+    assert_eq!(r["whirl_at_range_top"], true);
+    assert_eq!(r["scan"].as_array().unwrap().len(), 11);
+    let drops = r["drops"].as_u64().unwrap();
+    assert_eq!(drops, 11 + r["bisections"].as_array().unwrap().len() as u64);
     assert!(r["note"].as_str().is_some_and(|n| !n.is_empty()));
-    assert_eq!(v["tol_rpm"], 500.0);
+    assert_eq!(r["tol_rpm"], 125.0);
+    assert_eq!(r["model_version"], whirlmap_core::MODEL_VERSION);
+}
+
+#[test]
+fn two_ranges_that_contain_the_onset_give_the_same_onset() {
+    // The reproducer in small: before the lattice, the bracket moved with the range.
+    let search = |from: &str, to: &str| {
+        rows(&[
+            "--mu",
+            "0.4",
+            "--from",
+            from,
+            "--to",
+            to,
+            "--resolution-rpm",
+            "500",
+            "--tol-rpm",
+            "62.5",
+            "--duration-s",
+            "0.5",
+        ])[0]
+            .clone()
+    };
+    let wide = search("2000", "9000");
+    let narrow = search("3100", "5900");
+    let onset = |r: &serde_json::Value| r["onset_rpm"].as_f64().expect("an onset");
+    assert_eq!(onset(&wide), onset(&narrow), "{wide}\n{narrow}");
+    assert_eq!(wide["bracket_rpm"], narrow["bracket_rpm"]);
+}
+
+#[test]
+fn csv_rows_match_the_json_rows() {
+    let dir = temp_dir("critical-csv");
+    let csv = dir.join("critical.csv");
+    let rows = rows(&[
+        "--mu",
+        "0.3,0.4",
+        "--from",
+        "4000",
+        "--to",
+        "5000",
+        "--resolution-rpm",
+        "1000",
+        "--tol-rpm",
+        "1000",
+        "--duration-s",
+        "0.3",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 3, "{text}");
+    assert!(
+        lines[0].starts_with("mu,onset_rpm,bracket_below_rpm"),
+        "{text}"
+    );
+    for (line, row) in lines[1..].iter().zip(&rows) {
+        assert!(line.starts_with(&format!("{},", row["mu"])), "{line}");
+        let drops = row["drops"].to_string();
+        assert!(
+            line.contains(&format!(",{drops},")),
+            "{line} lacks drops {drops}"
+        );
+    }
 }
 
 #[test]
@@ -51,8 +135,10 @@ fn human_output_has_a_table_per_mu() {
         "2000",
         "--to",
         "2500",
-        "--scan-points",
-        "2",
+        "--resolution-rpm",
+        "500",
+        "--tol-rpm",
+        "500",
         "--duration-s",
         "0.1",
     ]);
@@ -65,8 +151,9 @@ fn human_output_has_a_table_per_mu() {
     for needle in [
         "mu_d = 0.3",
         "mu_d = 0.4",
-        "bracket",
-        "drops used",
+        "onset of whirl",
+        "whirl intervals",
+        "drops",
         "non-monotone",
         "note",
     ] {
@@ -101,6 +188,34 @@ fn bad_input_exits_2_naming_the_field_and_value() {
             "--tol-rpm",
         ),
         (&["--mu", "0.3,2.5", "--from", "0", "--to", "10"], "--mu"),
+        (&["--mu", "0.3,0.3", "--from", "0", "--to", "10"], "--mu"),
+        (&["--mu", "0.4", "--from", "0", "--to", "1e308"], "--to"),
+        (
+            &[
+                "--mu",
+                "0.4",
+                "--from",
+                "0",
+                "--to",
+                "1000",
+                "--resolution-rpm",
+                "0",
+            ],
+            "--resolution-rpm",
+        ),
+        (
+            &[
+                "--mu",
+                "0.4",
+                "--from",
+                "0",
+                "--to",
+                "1000",
+                "--tol-rpm",
+                "1e-300",
+            ],
+            "--tol-rpm",
+        ),
         (&["--mu", "-0.1", "--from", "0", "--to", "10"], "--mu"),
         (
             &[

@@ -2,7 +2,7 @@
 //! targets the model was fitted to.
 
 use whirlmap_core::{simulate, DropOptions, Scene};
-use whirlmap_sweep::classify::{ClassifyParams, OrbitClass};
+use whirlmap_sweep::classify::OrbitClass;
 use whirlmap_sweep::record::DropRecord;
 
 fn drop(speed_rpm: f64, mu: f64, duration_s: f64) -> DropRecord {
@@ -17,7 +17,7 @@ fn drop(speed_rpm: f64, mu: f64, duration_s: f64) -> DropRecord {
         },
     )
     .unwrap();
-    DropRecord::from_report(&r, &ClassifyParams::default())
+    DropRecord::from_report(&r)
 }
 
 #[test]

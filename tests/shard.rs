@@ -9,13 +9,18 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-/// 9 grid points, 3 critical searches, 2 orbit panels, every chart: with 4 shards the parts
-/// are uneven (3, 2, 2, 2 points) and shard 3 owns no critical search and no orbit.
+/// 9 grid points, 3 critical searches, 2 orbit panels, a probability ensemble, every chart:
+/// with 4 shards the parts are uneven (3, 2, 2, 2 points), shard 3 owns no critical search
+/// and no orbit, and shard 0 runs the ensemble.
 const SPEC: &str = r#"{
   "name": "shardtest",
   "duration_s": 0.1,
   "axes": {"speed_rpm": [4000, 8000, 12000], "mu": [0.1, 0.3, 0.4]},
-  "critical": {"mu": [0.3, 0.35, 0.4], "speed_rpm": {"from": 2000, "to": 12000}, "tol_rpm": 500},
+  "critical": {"mu": [0.3, 0.35, 0.4], "speed_rpm": {"from": 2000, "to": 12000},
+               "resolution_rpm": 2000, "tol_rpm": 500},
+  "probability": {"axes": {"speed_rpm": [4000, 8000], "mu": [0.3, 0.4]},
+                  "ensemble": {"members": 2, "seed": 7,
+                               "unbalance_m": {"uniform": {"from": 0, "to": 2e-6}}}},
   "orbits": {"speed_rpm": 8000, "mu": [0.1, 0.4]},
   "charts": ["orbits", "critical", "max_force", "peak_power", "classes"]
 }"#;
@@ -111,7 +116,9 @@ fn assert_same_result(single: &Path, merged: &Path) {
     assert_eq!(names, files(merged), "the same files");
     for n in &names {
         let name = n.to_str().unwrap();
-        if name == "manifest.json" || name == "timings.jsonl" {
+        // Run facts (wall times, threads) differ; the ensemble's manifest is one of them.
+        if name == "manifest.json" || name == "timings.jsonl" || name == "probability/manifest.json"
+        {
             continue;
         }
         assert!(

@@ -38,7 +38,11 @@ fn main() {
         let (k, v) = a.split_once('=').unwrap();
         match k {
             "rtol" => s.solver.rtol = v.parse().unwrap(),
-            "iso" => s.support_damping_isotropic = v.parse().unwrap(),
+            "radial" => {
+                if v == "true" {
+                    s.support_damper = SupportDamper::RadialOnly
+                }
+            }
             "gap" => s.solver.free_flight_gap_bound = v.parse().unwrap(),
             "ros" => {
                 if v == "true" {

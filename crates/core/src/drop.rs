@@ -1,6 +1,7 @@
 //! One drop, end to end: release, integrate through every located mode switch, stop at the
 //! duration or when the whirl stopping rule decides, and audit the energy.
 
+use crate::classify::{classify, Verdict};
 use crate::error::{InvalidParameter, SolveError};
 use crate::model::{ix, DropSystem, Mode, Slip, N};
 use crate::monitor::{Features, Monitor};
@@ -16,7 +17,12 @@ use std::ops::ControlFlow;
 
 /// Version of the model and its outputs; part of every record key. Bump it when a change
 /// alters results for the same scene.
-pub const MODEL_VERSION: u32 = 2;
+///
+/// - 3: the isotropic support damper is the default ([`crate::scene::SupportDamper`]);
+///   classes describe the settled motion on a final window, undecided runs are extended,
+///   and the whirl rule counts consecutive carried turns ([`crate::classify`]).
+/// - 2: a slip entered against the drifted slip velocity takes its sign.
+pub const MODEL_VERSION: u32 = 3;
 
 /// Largest first step after a mode switch (s): see [`Dopri5::cap_next_step`].
 pub(crate) const STEP_AFTER_SWITCH_S: f64 = 1e-7;
@@ -77,11 +83,12 @@ impl DropOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StopReason {
-    /// The requested duration was simulated.
+    /// The requested duration (or its extension, see [`DropReport::extension_s`]) was
+    /// simulated.
     DurationReached,
-    /// The contact point completed `whirl_stop_turns` net turns: whirl is decided, and in a
-    /// rigid housing it would only grow.
-    WhirlTurnsReached,
+    /// The contact point made the scene's `whirl_stop_turns` consecutive carried turns in
+    /// one direction: whirl is decided, and in a rigid housing it would only grow.
+    WhirlDecided,
     /// The rotor spin fell below the scene's `stop_speed_rpm`: the coast-down is over.
     StopSpeedReached,
 }
@@ -127,6 +134,11 @@ pub struct DropReport {
     pub final_state: [f64; N],
     /// Temperatures, thermal load and heat, when the scene carries a thermal model.
     pub thermal: Option<ThermalReport>,
+    /// The orbit class, whether it settled, and why ([`crate::classify`]).
+    pub verdict: Verdict,
+    /// How far the run was extended past its duration to let the class settle (s); 0 when
+    /// it settled (or stopped) by then.
+    pub extension_s: f64,
 }
 
 /// Passes every step to an extra observer, then to the monitor, which may stop the run, as
@@ -308,14 +320,21 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
     let mut y = sys.initial_state(scene.spin_rad_s());
     apply_release(scene, &mut y);
     let e0 = sys.mechanical_energy(&y, sys.mode);
+    let cls = &scene.classification;
     let mut mon = Monitor::new(
         opts.duration_s,
+        cls.window_s,
         opts.impact_merge_s,
         scene.spin_rad_s(),
         scene.clearance_m,
         scene.whirl_stop_turns,
+        cls.min_duty,
         opts.orbit_points,
     );
+    // A run not settled at its duration goes on in steps of half a window, up to the cap.
+    let extension_step_s = 0.5 * cls.window_s;
+    let end_cap_s = opts.duration_s + cls.max_extension_s;
+    let mut t_end = opts.duration_s;
     mon.start(&sys, &y);
     // The thermal model, if asked for: the dynamics then run in macro steps (crate::thermal).
     let mut thermal = match &scene.thermal {
@@ -334,15 +353,16 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
             thermal: thermal.as_mut(),
             synced: false,
         };
-        match integrate(
-            &sys,
-            &mut stepper,
-            &mut t,
-            &mut y,
-            opts.duration_s,
-            &mut tap,
-        )? {
-            Stop::EndTime => break StopReason::DurationReached,
+        match integrate(&sys, &mut stepper, &mut t, &mut y, t_end, &mut tap)? {
+            Stop::EndTime => {
+                let settled =
+                    classify(&mon.features(t, &y), StopReason::DurationReached, cls).settled;
+                if settled || t_end >= end_cap_s {
+                    break StopReason::DurationReached;
+                }
+                // A run shorter than the window goes straight to its length.
+                t_end = (t_end + extension_step_s).max(cls.window_s).min(end_cap_s);
+            }
             Stop::Observer if tap.speed_stopped => break StopReason::StopSpeedReached,
             Stop::Observer if tap.synced => {
                 // The network advanced: F_th (eq. 30) for the next macro step (eq. 31).
@@ -350,7 +370,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
                     sys.thermal_load_n = th.load_n();
                 }
             }
-            Stop::Observer => break StopReason::WhirlTurnsReached,
+            Stop::Observer => break StopReason::WhirlDecided,
             Stop::Event { index } => {
                 if stepper.stats().events >= scene.solver.max_events {
                     return Err(SolveError::EventBudget {
@@ -390,6 +410,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
         residual_rel: (e0 - e1 - losses).abs() / scale,
     };
     let (features, orbit) = mon.finish(&sys, t, &y);
+    let verdict = classify(&features, stop_reason, cls);
     let thermal = thermal.map(|th| th.finish(t, &y));
     Ok(DropReport {
         features,
@@ -401,5 +422,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
         scene_hash: scene.hash_hex(),
         final_state: y,
         thermal,
+        verdict,
+        extension_s: (t - opts.duration_s).max(0.0),
     })
 }

@@ -53,6 +53,7 @@
     clippy::needless_range_loop
 )]
 
+pub mod classify;
 pub mod drop;
 pub mod error;
 pub mod fidelity;
@@ -63,11 +64,12 @@ pub mod orbit;
 pub mod scene;
 pub mod thermal;
 
+pub use classify::{classify, ClassifyParams, OrbitClass, Reason, Verdict};
 pub use drop::{
     simulate, simulate_observed, DropOptions, DropReport, EnergyAudit, StopReason, MODEL_VERSION,
 };
 pub use error::{InvalidParameter, SolveError};
 pub use fidelity::Fidelity;
-pub use monitor::{Features, Window};
-pub use scene::{FrictionLaw, Method, Scene, SolverSettings};
+pub use monitor::{Features, Window, WindowStats};
+pub use scene::{FrictionLaw, Method, Scene, SolverSettings, SupportDamper};
 pub use thermal::{ThermalParams, ThermalReport};

@@ -5,11 +5,12 @@ use crate::model::{DropSystem, N};
 use crate::ode::{Dense, Observer, StepView};
 use crate::orbit::{Orbit, OrbitSample};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::ops::ControlFlow;
 
-/// Number of time bins the window statistics are kept in (fixed, so memory is O(1)).
-pub const BINS: usize = 64;
+/// Time bins of the classification window (a ring, so memory is O(1) however long the run
+/// is extended). Even, so the window splits into two halves of whole bins.
+pub const WINDOW_BINS: usize = 32;
 
 /// A running maximum located on the step interpolants (not the largest step-end value).
 #[derive(Debug, Clone, Copy, Default)]
@@ -18,49 +19,78 @@ struct Peak {
     time_s: f64,
 }
 
-/// Per-bin accumulators for the classification window.
+/// One time bin of the classification window.
 #[derive(Debug, Clone, Copy)]
 struct Bin {
+    /// Absolute index `floor(t / bin_s)` of the bin held in this ring slot; -1 when empty.
+    k: i64,
     duration_s: f64,
     contact_s: f64,
-    angle_integral: f64,
+    /// Time integrals of cos and sin of the contact angle (for the circular mean).
+    cos_dt: f64,
+    sin_dt: f64,
     angle_time_s: f64,
+    /// Unwrapped angle extremes and first and last samples in the bin (rad).
     angle_min: f64,
     angle_max: f64,
+    angle_first: f64,
+    angle_last: f64,
 }
 
-impl Default for Bin {
-    fn default() -> Self {
+impl Bin {
+    fn empty(k: i64) -> Self {
         Self {
+            k,
             duration_s: 0.0,
             contact_s: 0.0,
-            angle_integral: 0.0,
+            cos_dt: 0.0,
+            sin_dt: 0.0,
             angle_time_s: 0.0,
             angle_min: f64::INFINITY,
             angle_max: f64::NEG_INFINITY,
+            angle_first: f64::NAN,
+            angle_last: f64::NAN,
         }
     }
 }
 
-/// Statistics over the classification window: the second half of the simulated time.
+/// Statistics of the contact over a stretch of time (the final window or one of its halves).
+/// Angles are measured from the bottom of the race, counter-clockwise positive, while the
+/// rotor is within half a clearance of the race wall.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Window {
-    /// Window start (s).
+pub struct WindowStats {
+    /// Start (s).
     pub start_s: f64,
-    /// Window end = end of the run (s).
+    /// End (s).
     pub end_s: f64,
-    /// Fraction of the window with the rotor-race contact active.
+    /// Fraction of the time with the rotor-race contact active.
     pub contact_duty: f64,
-    /// Smallest unwrapped contact angle in the window, from the bottom of the race (rad;
-    /// counter-clockwise positive). NaN when the rotor never came near the race.
-    pub angle_min_rad: f64,
-    /// Largest unwrapped contact angle in the window (rad).
-    pub angle_max_rad: f64,
-    /// Time-mean unwrapped contact angle in the window (rad).
+    /// Time with the contact angle measured (s); 0 when the rotor never came near the wall.
+    pub angle_time_s: f64,
+    /// Circular (time-weighted) mean of the contact angle, in (-pi, pi] (rad). NaN without
+    /// angle samples.
     pub angle_mean_rad: f64,
+    /// Circular standard deviation `sqrt(-2 ln R)` of the contact angle, R the mean
+    /// resultant length (rad). NaN without angle samples.
+    pub angle_spread_rad: f64,
+    /// Range (largest minus smallest) of the unwrapped contact angle (rad). NaN without
+    /// angle samples.
+    pub angle_range_rad: f64,
+    /// Net turns of the contact point, signed relative to the spin (negative: against it).
+    pub net_turns: f64,
 }
 
-/// What a drop measured, streamed; the classifier (sweep crate) reads only this.
+/// The final classification window: the last `window_s` of the run.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Window {
+    /// Whether the run is at least as long as the window.
+    pub full: bool,
+    /// The window's statistics.
+    #[serde(flatten)]
+    pub stats: WindowStats,
+}
+
+/// What a drop measured, streamed; the classifier ([`crate::classify`]) reads only this.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Features {
     /// Peak normal force of the first impact after free fall (N); impact episodes closer
@@ -81,27 +111,168 @@ pub struct Features {
     /// Total time with the contact active (s).
     pub contact_time_s: f64,
     /// Net turns of the contact angle since first touch, signed relative to the spin
-    /// (negative: opposite to the spin, i.e. backward).
+    /// (negative: against the spin).
     pub net_whirl_turns: f64,
-    /// Whirl frequency (Hz), signed relative to the spin (negative is backward whirl):
-    /// from the times of completed net turns when there are two or more, else the net
-    /// contact-angle rate over the window.
+    /// Net turns made before the motion that decides the class: from first touch to the
+    /// start of the final window, or to the start of the whirl streak when the whirl rule
+    /// stopped the run. Signed relative to the spin. A transient whirl that dies out shows
+    /// here, not in the class.
+    pub transient_whirl_turns: f64,
+    /// Consecutive turns of the contact point in one direction at the end of the run, each
+    /// made with the contact carried and faster than one turn per half window; signed
+    /// relative to the spin. The whirl rule stops the run when it reaches the scene's
+    /// `whirl_stop_turns`.
+    pub whirl_streak_turns: f64,
+    /// Whirl frequency (Hz), signed relative to the spin (negative is backward whirl): from
+    /// the times of the streak's turns when it has two or more, else the net contact-angle
+    /// rate over the final window.
     pub whirl_frequency_hz: f64,
-    /// Window statistics for the classifier.
+    /// The final window.
     pub window: Window,
+    /// The window's first and second halves (the classifier asks both to agree).
+    pub window_halves: [WindowStats; 2],
     /// Rotor spin at the end (r/min).
     pub final_rotor_speed_rpm: f64,
     /// Race spin at the end (r/min).
     pub final_race_speed_rpm: f64,
 }
 
+impl WindowStats {
+    /// Statistics of an empty stretch from `t0` to `t1` (no contact, no angle samples).
+    pub fn empty(start_s: f64, end_s: f64) -> Self {
+        Self {
+            start_s,
+            end_s,
+            contact_duty: 0.0,
+            angle_time_s: 0.0,
+            angle_mean_rad: f64::NAN,
+            angle_spread_rad: f64::NAN,
+            angle_range_rad: f64::NAN,
+            net_turns: 0.0,
+        }
+    }
+}
+
+impl Features {
+    /// The features of a run that measured nothing (the starting point of synthetic
+    /// feature series in tests).
+    pub fn empty() -> Self {
+        let w = WindowStats::empty(0.0, 0.0);
+        Self {
+            first_contact_force_n: 0.0,
+            max_contact_force_n: 0.0,
+            max_contact_force_time_s: 0.0,
+            peak_friction_power_w: 0.0,
+            peak_heat_power_w: 0.0,
+            impacts: 0,
+            first_contact_time_s: f64::NAN,
+            contact_time_s: 0.0,
+            net_whirl_turns: 0.0,
+            transient_whirl_turns: 0.0,
+            whirl_streak_turns: 0.0,
+            whirl_frequency_hz: 0.0,
+            window: Window {
+                full: false,
+                stats: w,
+            },
+            window_halves: [w; 2],
+            final_rotor_speed_rpm: 0.0,
+            final_race_speed_rpm: 0.0,
+        }
+    }
+}
+
+/// Consecutive turns of the contact point in one direction (the whirl rule's counter).
+///
+/// A turn completes when the unwrapped angle has moved a full turn from the reference. It
+/// extends the streak when it was made with the contact carried (duty of at least
+/// `min_duty` over the turn), faster than `max_turn_s`, and in the streak's direction; a
+/// carried turn the other way starts a new streak; any other turn ends it. Moving back by
+/// more than a quarter turn against the streak also ends it (a rocking rotor).
+#[derive(Debug, Clone, Copy)]
+struct Streak {
+    min_duty: f64,
+    max_turn_s: f64,
+    ref_angle: f64,
+    ref_t: f64,
+    ref_contact_s: f64,
+    /// Signed count of consecutive turns (positive counter-clockwise).
+    count: f64,
+    /// Unwrapped angle where the streak began.
+    start_angle: f64,
+    first_turn_s: f64,
+    last_turn_s: f64,
+}
+
+impl Streak {
+    fn new(min_duty: f64, max_turn_s: f64) -> Self {
+        Self {
+            min_duty,
+            max_turn_s,
+            ref_angle: f64::NAN,
+            ref_t: 0.0,
+            ref_contact_s: 0.0,
+            count: 0.0,
+            start_angle: f64::NAN,
+            first_turn_s: f64::NAN,
+            last_turn_s: f64::NAN,
+        }
+    }
+
+    fn reset_at(&mut self, angle: f64, t: f64, contact_s: f64) {
+        self.ref_angle = angle;
+        self.ref_t = t;
+        self.ref_contact_s = contact_s;
+    }
+
+    fn update(&mut self, angle: f64, t: f64, contact_s: f64) {
+        if self.ref_angle.is_nan() {
+            self.reset_at(angle, t, contact_s);
+            return;
+        }
+        let d = angle - self.ref_angle;
+        if d.abs() >= TAU {
+            let dir = d.signum();
+            let dt = t - self.ref_t;
+            let duty = if dt > 0.0 {
+                (contact_s - self.ref_contact_s) / dt
+            } else {
+                0.0
+            };
+            let whirl_turn = duty >= self.min_duty && dt <= self.max_turn_s;
+            if whirl_turn && self.count * dir >= 0.0 {
+                if self.count == 0.0 {
+                    self.start_angle = self.ref_angle;
+                    self.first_turn_s = t;
+                }
+                self.count += dir;
+                self.last_turn_s = t;
+            } else if whirl_turn {
+                self.count = dir;
+                self.start_angle = self.ref_angle;
+                self.first_turn_s = t;
+                self.last_turn_s = t;
+            } else {
+                self.count = 0.0;
+            }
+            let ref_angle = self.ref_angle + dir * TAU;
+            self.reset_at(ref_angle, t, contact_s);
+        } else if self.count != 0.0 && d * self.count.signum() < -FRAC_PI_2 {
+            self.count = 0.0;
+            self.reset_at(angle, t, contact_s);
+        }
+    }
+}
+
 /// The observer a drop runs with.
 pub struct Monitor {
-    duration_s: f64,
     merge_s: f64,
     spin_sign: f64,
     near_wall_m: f64,
     stop_turns: f64,
+    /// Classification window length (s) and bin width (s).
+    window_s: f64,
+    bin_s: f64,
     max_fn: Peak,
     max_hs: Peak,
     max_h: Peak,
@@ -113,10 +284,11 @@ pub struct Monitor {
     angle_raw_prev: Option<f64>,
     angle: f64,
     angle_at_first_contact: Option<f64>,
-    turns_done: u64,
-    first_turn_s: f64,
-    last_turn_s: f64,
-    bins: [Bin; BINS],
+    streak: Streak,
+    /// The window ring: slot `k mod WINDOW_BINS` holds bin `k`.
+    bins: [Bin; WINDOW_BINS],
+    /// Absolute index of the newest bin (-1 before the first step).
+    cur_k: i64,
     last_t: f64,
     orbit: Option<Orbit>,
     orbit_dt: f64,
@@ -176,23 +348,30 @@ fn golden_max(mut q: impl FnMut(f64) -> f64, mut a: f64, mut b: f64) -> (f64, f6
 }
 
 impl Monitor {
-    /// A monitor for a run of `duration_s` (s), merging impacts closer than `merge_s`,
-    /// stopping after `stop_turns` net whirl turns, recording an orbit of about
-    /// `orbit_points` samples when that is `Some`.
+    /// A monitor for a run of `duration_s` (s) classified on a final window of `window_s`
+    /// (see [`crate::classify::ClassifyParams::window_s`]), merging impacts closer than
+    /// `merge_s`, stopping after `stop_turns` consecutive whirl turns made with a contact duty
+    /// of at least `min_duty`, recording an orbit of about `orbit_points` samples when that
+    /// is `Some`.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         duration_s: f64,
+        window_s: f64,
         merge_s: f64,
         spin_rad_s: f64,
         clearance_m: f64,
         stop_turns: f64,
+        min_duty: f64,
         orbit_points: Option<usize>,
     ) -> Self {
+        let bin_s = window_s / WINDOW_BINS as f64;
         Self {
-            duration_s,
             merge_s,
             spin_sign: if spin_rad_s < 0.0 { -1.0 } else { 1.0 },
             near_wall_m: 0.5 * clearance_m,
             stop_turns,
+            window_s,
+            bin_s,
             max_fn: Peak::default(),
             max_hs: Peak::default(),
             max_h: Peak::default(),
@@ -204,10 +383,10 @@ impl Monitor {
             angle_raw_prev: None,
             angle: 0.0,
             angle_at_first_contact: None,
-            turns_done: 0,
-            first_turn_s: f64::NAN,
-            last_turn_s: f64::NAN,
-            bins: [Bin::default(); BINS],
+            // A whirl turn must be at least as fast as the window rule's whirl travel.
+            streak: Streak::new(min_duty, 0.5 * window_s),
+            bins: [Bin::empty(-1); WINDOW_BINS],
+            cur_k: -1,
             last_t: 0.0,
             orbit: orbit_points.map(|_| Orbit {
                 clearance_m,
@@ -294,11 +473,14 @@ impl Monitor {
         }
     }
 
-    fn track_angle(&mut self, y: &[f64; N], t: f64) {
+    /// Updates the unwrapped contact angle from state `y` at time `t` (only while the rotor
+    /// is within half a clearance of the wall) and the whirl streak; returns whether the
+    /// angle was measured.
+    fn track_angle(&mut self, y: &[f64; N], t: f64) -> bool {
         use crate::model::ix::*;
         let (dx, dy) = (y[XR] - y[XB], y[YR] - y[YB]);
         if (dx * dx + dy * dy).sqrt() < self.near_wall_m {
-            return;
+            return false;
         }
         // Angle from the bottom of the race, counter-clockwise positive.
         let raw = dy.atan2(dx) + 0.5 * PI;
@@ -307,37 +489,106 @@ impl Monitor {
             Some(prev) => self.angle += (raw - prev + PI).rem_euclid(TAU) - PI,
         }
         self.angle_raw_prev = Some(raw);
-        if let Some(a0) = self.angle_at_first_contact {
-            let turns = ((self.angle - a0) / TAU).abs();
-            let k = turns.floor() as u64;
-            if k > self.turns_done {
-                if self.turns_done == 0 {
-                    self.first_turn_s = t;
-                }
-                self.turns_done = k;
-                self.last_turn_s = t;
-            }
-            if turns >= self.stop_turns {
+        if self.angle_at_first_contact.is_some() {
+            self.streak.update(self.angle, t, self.contact_s);
+            if self.streak.count.abs() >= self.stop_turns {
                 self.whirl_decided = true;
             }
         }
+        true
     }
 
-    fn bin_step(&mut self, t0: f64, t1: f64, contact: bool, angle_mid: Option<f64>) {
-        let w = self.duration_s / BINS as f64;
-        let i = ((0.5 * (t0 + t1) / w) as usize).min(BINS - 1);
+    /// The ring slot of bin `k`, emptied first when it still holds an older bin.
+    fn bin_mut(&mut self, k: i64) -> &mut Bin {
+        if k > self.cur_k {
+            let first = (self.cur_k + 1).max(k - WINDOW_BINS as i64 + 1);
+            for kk in first..=k {
+                self.bins[kk.rem_euclid(WINDOW_BINS as i64) as usize] = Bin::empty(kk);
+            }
+            self.cur_k = k;
+        }
+        &mut self.bins[k.rem_euclid(WINDOW_BINS as i64) as usize]
+    }
+
+    /// Books a step `[t0, t1]` (to the bin of its midpoint) with its contact state and the
+    /// contact angles measured at its midpoint and end.
+    fn bin_step(&mut self, t0: f64, t1: f64, contact: bool, mid: Option<f64>, end: Option<f64>) {
+        let k = (0.5 * (t0 + t1) / self.bin_s).floor() as i64;
         let h = t1 - t0;
-        let b = &mut self.bins[i];
+        let b = self.bin_mut(k);
         b.duration_s += h;
         if contact {
             b.contact_s += h;
         }
-        if let Some(a) = angle_mid {
-            b.angle_integral += a * h;
+        if let Some(a) = mid {
+            b.cos_dt += a.cos() * h;
+            b.sin_dt += a.sin() * h;
             b.angle_time_s += h;
+        }
+        for a in [mid, end].into_iter().flatten() {
             b.angle_min = b.angle_min.min(a);
             b.angle_max = b.angle_max.max(a);
+            if b.angle_first.is_nan() {
+                b.angle_first = a;
+            }
+            b.angle_last = a;
         }
+    }
+
+    /// Statistics over the bins `k0..=k1` of the ring, ending at `t_end`.
+    fn stats(&self, k0: i64, k1: i64, t_end: f64) -> WindowStats {
+        let mut w = WindowStats::empty(k0.max(0) as f64 * self.bin_s, t_end);
+        let (mut dur, mut con, mut c, mut sn, mut at) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        let (mut amin, mut amax) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut first, mut last) = (f64::NAN, f64::NAN);
+        for k in k0.max(0)..=k1 {
+            let b = &self.bins[k.rem_euclid(WINDOW_BINS as i64) as usize];
+            if b.k != k {
+                continue;
+            }
+            dur += b.duration_s;
+            con += b.contact_s;
+            c += b.cos_dt;
+            sn += b.sin_dt;
+            at += b.angle_time_s;
+            amin = amin.min(b.angle_min);
+            amax = amax.max(b.angle_max);
+            if first.is_nan() {
+                first = b.angle_first;
+            }
+            if !b.angle_last.is_nan() {
+                last = b.angle_last;
+            }
+        }
+        if dur > 0.0 {
+            w.contact_duty = con / dur;
+        }
+        if at > 0.0 {
+            let (mc, ms) = (c / at, sn / at);
+            w.angle_time_s = at;
+            w.angle_mean_rad = ms.atan2(mc);
+            let r = mc.hypot(ms).min(1.0);
+            w.angle_spread_rad = (-2.0 * r.max(1e-300).ln()).sqrt();
+        }
+        if amax >= amin {
+            w.angle_range_rad = amax - amin;
+        }
+        if !first.is_nan() && !last.is_nan() {
+            w.net_turns = (last - first) / TAU * self.spin_sign;
+        }
+        w
+    }
+
+    /// The unwrapped angle at the start of bins `k0..`: the first sample there, else the
+    /// current angle.
+    fn angle_from(&self, k0: i64) -> f64 {
+        for k in k0.max(0)..=self.cur_k {
+            let b = &self.bins[k.rem_euclid(WINDOW_BINS as i64) as usize];
+            if b.k == k && !b.angle_first.is_nan() {
+                return b.angle_first;
+            }
+        }
+        self.angle
     }
 
     fn record_orbit(&mut self, sys: &DropSystem, t: f64, y: &[f64; N], force: bool) {
@@ -361,53 +612,49 @@ impl Monitor {
         self.record_orbit(sys, 0.0, y, true);
     }
 
-    /// Final features after the run ended at `t_end` in state `y`.
-    pub fn finish(
-        mut self,
-        sys: &DropSystem,
-        t_end: f64,
-        y: &[f64; N],
-    ) -> (Features, Option<Orbit>) {
-        self.record_orbit(sys, t_end, y, true);
-        let w = self.duration_s / BINS as f64;
-        let start_s = 0.5 * t_end;
-        let first = ((start_s / w) as usize).min(BINS - 1);
-        let (mut dur, mut con, mut ai, mut at, mut amin, mut amax) =
-            (0.0, 0.0, 0.0, 0.0, f64::INFINITY, f64::NEG_INFINITY);
-        for b in &self.bins[first..] {
-            dur += b.duration_s;
-            con += b.contact_s;
-            ai += b.angle_integral;
-            at += b.angle_time_s;
-            amin = amin.min(b.angle_min);
-            amax = amax.max(b.angle_max);
-        }
+    /// The features so far, at time `t_end` in state `y` (the driver asks whether the class
+    /// has settled before it ends a run).
+    pub fn features(&self, t_end: f64, y: &[f64; N]) -> Features {
+        let half = (WINDOW_BINS / 2) as i64;
+        let k1 = self.cur_k;
+        let k0 = k1 - WINDOW_BINS as i64 + 1;
+        let stats = self.stats(k0, k1, t_end);
+        let halves = [
+            {
+                let mut h = self.stats(k0, k0 + half - 1, t_end);
+                h.end_s = (k0 + half).max(0) as f64 * self.bin_s;
+                h
+            },
+            self.stats(k0 + half, k1, t_end),
+        ];
         let window = Window {
-            start_s: first as f64 * w,
-            end_s: t_end,
-            contact_duty: if dur > 0.0 { con / dur } else { 0.0 },
-            angle_min_rad: if at > 0.0 { amin } else { f64::NAN },
-            angle_max_rad: if at > 0.0 { amax } else { f64::NAN },
-            angle_mean_rad: if at > 0.0 { ai / at } else { f64::NAN },
+            // The window is full once the run has passed its length (to bin rounding).
+            full: k0 >= 0 && t_end >= self.window_s * (1.0 - 1e-9),
+            stats,
         };
-        let net = self
-            .angle_at_first_contact
-            .map_or(0.0, |a0| (self.angle - a0) / TAU);
-        let whirl_frequency_hz = if self.turns_done >= 2 && self.last_turn_s > self.first_turn_s {
-            net.signum() * (self.turns_done - 1) as f64 / (self.last_turn_s - self.first_turn_s)
-        } else if let Some(a0) = self.angle_at_first_contact {
-            let t0 = self.first_contact_s;
-            if t_end > t0 {
-                (self.angle - a0) / TAU / (t_end - t0)
-            } else {
-                0.0
-            }
+        let turns_from = |a: f64| {
+            self.angle_at_first_contact
+                .map_or(0.0, |a0| (a - a0) / TAU * self.spin_sign)
+        };
+        let net = turns_from(self.angle);
+        let streak = self.streak.count * self.spin_sign;
+        let transient_whirl_turns = if self.whirl_decided {
+            turns_from(self.streak.start_angle)
+        } else {
+            turns_from(self.angle_from(k0))
+        };
+        let st = &self.streak;
+        let whirl_frequency_hz = if st.count.abs() >= 2.0 && st.last_turn_s > st.first_turn_s {
+            st.count.signum() * (st.count.abs() - 1.0) / (st.last_turn_s - st.first_turn_s)
+                * self.spin_sign
+        } else if stats.end_s > stats.start_s {
+            stats.net_turns / (stats.end_s - stats.start_s)
         } else {
             0.0
         };
         use crate::model::ix::*;
         let to_rpm = 30.0 / PI;
-        let features = Features {
+        Features {
             first_contact_force_n: self.first_impact_fn,
             max_contact_force_n: self.max_fn.value,
             max_contact_force_time_s: self.max_fn.time_s,
@@ -416,13 +663,26 @@ impl Monitor {
             impacts: self.impacts,
             first_contact_time_s: self.first_contact_s,
             contact_time_s: self.contact_s,
-            net_whirl_turns: net * self.spin_sign,
-            whirl_frequency_hz: whirl_frequency_hz * self.spin_sign,
+            net_whirl_turns: net,
+            transient_whirl_turns,
+            whirl_streak_turns: streak,
+            whirl_frequency_hz,
             window,
+            window_halves: halves,
             final_rotor_speed_rpm: y[WR] * to_rpm,
             final_race_speed_rpm: y[WB] * to_rpm,
-        };
-        (features, self.orbit)
+        }
+    }
+
+    /// Final features after the run ended at `t_end` in state `y`, and the orbit.
+    pub fn finish(
+        mut self,
+        sys: &DropSystem,
+        t_end: f64,
+        y: &[f64; N],
+    ) -> (Features, Option<Orbit>) {
+        self.record_orbit(sys, t_end, y, true);
+        (self.features(t_end, y), self.orbit)
     }
 }
 
@@ -436,7 +696,7 @@ impl Observer<DropSystem, N> for Monitor {
         if contact {
             self.contact_s += t1 - t0;
             if self.angle_at_first_contact.is_none() {
-                self.track_angle(&y0, t0);
+                let _ = self.track_angle(&y0, t0);
                 self.angle_at_first_contact = Some(self.angle);
             }
         }
@@ -456,10 +716,9 @@ impl Observer<DropSystem, N> for Monitor {
         };
         self.track_peaks(sys, d, [t0, tm, t1], [&s0, &sm, &s1]);
         self.prev_end = Some((t1, s1));
-        self.track_angle(&ym, tm);
-        let angle_mid = self.angle_raw_prev.map(|_| self.angle);
-        self.track_angle(&y1, t1);
-        self.bin_step(t0, t1, contact, angle_mid);
+        let angle_mid = self.track_angle(&ym, tm).then_some(self.angle);
+        let angle_end = self.track_angle(&y1, t1).then_some(self.angle);
+        self.bin_step(t0, t1, contact, angle_mid, angle_end);
         self.last_t = t1;
         self.record_orbit(sys, t1, &y1, false);
         if self.whirl_decided {

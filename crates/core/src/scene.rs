@@ -5,6 +5,7 @@
 //! defaults (`Scene::paper()`); catalogue units (N/mm^1.5, cSt, N mm) are converted here and
 //! in [`crate::model::drag`], nowhere else.
 
+use crate::classify::ClassifyParams;
 use crate::error::InvalidParameter;
 use crate::thermal::ThermalParams;
 use serde::{Deserialize, Serialize};
@@ -48,6 +49,27 @@ impl Method {
     }
 }
 
+/// How the race-on-balls damper c2 of Table 4 acts on the race's velocity.
+///
+/// The lumped support stands for a ball set. Its stiffness is isotropic already (the Hertz
+/// law along the displacement is an isotropic potential). Each ball's contact damper acts
+/// along its own line; summed over a half-loaded zone the set's damping matrix is
+/// `c diag(sum cos^2 psi, sum sin^2 psi)`, equal terms, so a ball set damps the race's
+/// tangential motion as much as its radial motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SupportDamper {
+    /// `c2` on the race's whole velocity (damping matrix `c2 I`): the ball-set argument above.
+    /// The default from `MODEL_VERSION` 3.
+    #[default]
+    Isotropic,
+    /// `c2` on the race's radial rate only: eq. 7 read literally for the support, the law
+    /// the paper prints. The race's tangential vibration on its support (about 2.85 kHz) is
+    /// then undamped and re-excited at every friction switch, so forces move with the
+    /// solver tolerance and near-boundary classes flip.
+    RadialOnly,
+}
+
 /// Integrator settings that change results (so they are part of the scene and its hash).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -82,7 +104,7 @@ pub struct SolverSettings {
     /// Factor on the absolute tolerances of the race's translation (its centre's position
     /// and velocity). The race centre is a fast variable held by two stiff springs (its own
     /// modes at 3-16 kHz): with its support damped in every direction
-    /// (`support_damping_isotropic`) and an L-stable stepper (`ros34pw2`) its local errors
+    /// (`support_damper = isotropic`, the default) and an L-stable stepper (`ros34pw2`) its local errors
     /// decay instead of accumulating, and the default absolute tolerances (the rotor's:
     /// `rtol * position_scale_m` on positions, `rtol * sqrt(2 g s) / 100` on velocities)
     /// are what bound the implicit step in contact. The accuracy this costs is measured by `whirlmap accuracy`
@@ -190,14 +212,11 @@ pub struct Scene {
     pub support_exponent: f64,
     /// Race-on-balls damping c2 (N s/m). Table 4: 750. Allowed >= 0.
     pub support_damping_n_s_per_m: f64,
-    /// The support damper c2 acts on the race's whole velocity (an isotropic damping matrix
-    /// c2 I) instead of its radial rate only. A ball set whose balls each damp their own
-    /// deformation rate sums to an isotropic matrix over a half-loaded zone (sum of cos^2 =
-    /// sum of sin^2), so this damps the race's tangential vibration on its support (about
-    /// 3 kHz), which the radial damper leaves undamped. Default false (eq. 7 read as a
-    /// radial damper); omitted from the canonical JSON while false.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub support_damping_isotropic: bool,
+    /// How the support damper c2 acts on the race ([`SupportDamper`]). Default
+    /// `isotropic` (from `MODEL_VERSION` 3): a ball set damps the race in every direction.
+    /// `radial_only` is eq. 7 read literally for the support (the paper's law), which leaves
+    /// the race's tangential vibration on its support (about 2.85 kHz) undamped.
+    pub support_damper: SupportDamper,
 
     // ---- Palmgren drag of the touchdown bearing (eqs. 11-13) ------------------------------
     /// Drag torque on the race switched on. Default true.
@@ -217,9 +236,15 @@ pub struct Scene {
     pub drag_zero_speed_rad_s: f64,
 
     // ---- run control ---------------------------------------------------------------------
-    /// Net whirl turns of the contact point after which a run is stopped as decided whirl
-    /// (backward whirl grows without bound in a rigid housing). Default 5. Allowed >= 1.
+    /// Consecutive turns of the contact point in one direction, each made with the contact
+    /// carried (duty of at least `classification.min_duty` within the turn), after which a
+    /// run is stopped as decided whirl: backward whirl grows without bound in a rigid
+    /// housing, so a whirl run needs a stopping rule. Turns made before the rotor settles
+    /// (a transient whirl that dies out) do not count. Default 5. Allowed [1, 1e6].
     pub whirl_stop_turns: f64,
+    /// How a drop's orbit is classified and how long an undecided run is extended
+    /// ([`ClassifyParams`]).
+    pub classification: ClassifyParams,
     /// Integrator settings.
     pub solver: SolverSettings,
 
@@ -270,7 +295,6 @@ impl Scene {
         "release_velocity_m_s",
         "race_speed_rad_s",
         "quasi_static_race",
-        "support_damping_isotropic",
         "stop_speed_rpm",
         "thermal",
         "solver.method",
@@ -304,7 +328,7 @@ impl Scene {
             support_stiffness_n_per_m_e: K2_TABLE4_N_PER_M15,
             support_exponent: 1.5,
             support_damping_n_s_per_m: 750.0,
-            support_damping_isotropic: false,
+            support_damper: SupportDamper::Isotropic,
             drag_enabled: true,
             palmgren_f0: 2.0,
             lubricant_viscosity_mm2_s: 22.0,
@@ -312,6 +336,7 @@ impl Scene {
             static_load_rating_n: 10_000.0,
             drag_zero_speed_rad_s: 0.1,
             whirl_stop_turns: 5.0,
+            classification: ClassifyParams::default(),
             solver: SolverSettings::default(),
             quasi_static_race: false,
             stop_speed_rpm: None,
@@ -566,6 +591,7 @@ impl Scene {
         if s.max_events == 0 {
             return Err(InvalidParameter::new("solver.max_events", 0, ">= 1"));
         }
+        self.classification.validate()?;
         if let Some(v) = self.stop_speed_rpm {
             check(
                 "stop_speed_rpm",

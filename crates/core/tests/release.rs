@@ -27,7 +27,6 @@ fn optional_fields_are_exactly_those_the_json_omits_at_their_default() {
     t.release_velocity_m_s = [0.0, -1e-3];
     t.race_speed_rad_s = 1.0;
     t.quasi_static_race = true;
-    t.support_damping_isotropic = true;
     t.stop_speed_rpm = Some(100.0);
     t.thermal = Some(Default::default());
     t.solver.method = whirlmap_core::Method::Ros34pw2;
@@ -102,6 +101,8 @@ fn free_flight_from_an_offset_release_is_a_straight_line() {
     s.release_offset_m = [20e-6, -10e-6];
     s.release_velocity_m_s = [1e-3, 2e-3];
     s.race_speed_rad_s = 50.0;
+    // Exactly 0.02 s (no contact, so the classifier would extend the run otherwise).
+    s.classification.max_extension_s = 0.0;
     let t = 0.02; // 20-40 um travel: stays clear of the 150 um clearance
     let r = simulate(
         &s,

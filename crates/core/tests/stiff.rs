@@ -111,14 +111,14 @@ fn jacobian_matches_finite_differences_with_regularised_friction_and_quasi_stati
 }
 
 #[test]
-fn jacobian_matches_finite_differences_with_isotropic_support_damping() {
+fn jacobian_matches_finite_differences_with_the_radial_only_support_damper() {
     let mut s = Scene::paper();
     s.mu_dynamic = 0.3;
-    s.support_damping_isotropic = true;
+    s.support_damper = whirlmap_core::SupportDamper::RadialOnly;
     let c = check(s);
     assert!(c.checked[0] > 3 && c.checked[1] > 3, "{:?}", c.checked);
     eprintln!(
-        "isotropic support damper: worst {:e}, checks {:?}",
+        "radial-only support damper: worst {:e}, checks {:?}",
         c.worst, c.checked
     );
 }

@@ -1,10 +1,11 @@
-//! `support_damping_isotropic`: the support damper c2 acting on the race's whole velocity
-//! (eq. 7's damper in every direction of the ball set) instead of its radial rate only.
+//! `support_damper`: the support damper c2 acting on the race's whole velocity (`isotropic`,
+//! the default: eq. 7's damper in every direction of the ball set) or on its radial rate only
+//! (`radial_only`, the paper's law read literally).
 
 use std::ops::ControlFlow;
 use whirlmap_core::model::{ix, DropSystem, N};
 use whirlmap_core::ode::{Observer, StepView};
-use whirlmap_core::{simulate, simulate_observed, DropOptions, Method, Scene};
+use whirlmap_core::{simulate, simulate_observed, DropOptions, Method, Scene, SupportDamper};
 
 /// The race centre on its support at the static sag, moving with velocity `v`: the support
 /// force's tangential part is `-c2 v_t` with the option and zero without, the radial part is
@@ -16,7 +17,11 @@ fn tangential_damper_force_and_power_follow_eq_7_componentwise() {
     let c2 = s.support_damping_n_s_per_m;
     let mut out = Vec::new();
     for iso in [false, true] {
-        s.support_damping_isotropic = iso;
+        s.support_damper = if iso {
+            SupportDamper::Isotropic
+        } else {
+            SupportDamper::RadialOnly
+        };
         let mut sys = DropSystem::new(&s);
         let mut y = sys.initial_state(0.0);
         // Race below the centre (n_b = -y), moving right (tangential) and down (radial).
@@ -70,7 +75,11 @@ impl Observer<DropSystem, N> for Ringing {
 
 fn ringing(iso: bool) -> f64 {
     let mut s = Scene::paper();
-    s.support_damping_isotropic = iso;
+    s.support_damper = if iso {
+        SupportDamper::Isotropic
+    } else {
+        SupportDamper::RadialOnly
+    };
     s.solver.rtol = 1e-8;
     let mut r = Ringing {
         t_a: 0.20,
@@ -113,7 +122,7 @@ fn energy_audit_closes_with_isotropic_support_damping() {
         (0.4, Method::Ros34pw2),
     ] {
         let mut s = Scene::paper();
-        s.support_damping_isotropic = true;
+        s.support_damper = SupportDamper::Isotropic;
         s.mu_dynamic = mu;
         s.solver.method = method;
         s.solver.rtol = 1e-7;

@@ -11,7 +11,7 @@
 //! A case file (`sweeps/accuracy-cases.json`) names the cases, the tolerance ladder and the
 //! settings; scene keys are set by [`crate::overrides::apply`] (dotted for nested fields).
 
-use crate::classify::{classify, ClassifyParams, OrbitClass};
+use crate::classify::OrbitClass;
 use crate::overrides::{self, OverrideError};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -286,7 +286,7 @@ pub fn measure(scene: &Scene, duration_s: f64, record_orbit: bool) -> Result<Mea
     let wall_ms = t.elapsed().as_secs_f64() * 1e3;
     let f = &r.features;
     Ok(Measured {
-        class: classify(f, r.stop_reason, &ClassifyParams::default()),
+        class: r.verdict.class,
         first_contact_force_n: f.first_contact_force_n,
         max_contact_force_n: f.max_contact_force_n,
         peak_heat_power_w: f.peak_heat_power_w,

@@ -24,6 +24,9 @@ use serde_json::Value;
 use whirlmap_core::orbit::Orbit;
 
 use crate::classify::OrbitClass;
+use crate::critical::CriticalRow;
+use crate::ensemble::ContoursFile;
+use crate::fig4::{band_points, Fig4};
 use crate::render::{
     chart_header, chart_mesh, chart_quantity, chart_text_style, chart_tick_formatter,
     decimate_samples, orbit_panel, render, DrawResult, Figure, RenderError, AXIS_DESC_FONT,
@@ -40,7 +43,7 @@ const SPEED_KEYS: [&str; 1] = ["speed_rpm"];
 const MU_KEYS: [&str; 2] = ["mu", "mu_dynamic"];
 
 const SPEED_DESC: &str = "release speed (r/min)";
-const MU_DESC: &str = "friction coefficient µ (-)";
+pub(crate) const MU_DESC: &str = "friction coefficient µ (-)";
 
 /// Why charts could not be drawn.
 #[derive(Debug, thiserror::Error)]
@@ -440,10 +443,10 @@ const HATCH: RGBColor = RGBColor(120, 120, 120);
 const FAILED_BG: RGBColor = RGBColor(252, 226, 226);
 const FAILED_MARK: RGBColor = RGBColor(170, 20, 20);
 const CONTOUR: RGBColor = RGBColor(25, 25, 25);
-const BAND: RGBColor = RGBColor(214, 39, 40);
+pub(crate) const BAND: RGBColor = RGBColor(214, 39, 40);
 
 /// The colour of each class on the class map and Fig. 4.
-fn class_colour(c: OrbitClass) -> RGBColor {
+pub(crate) fn class_colour(c: OrbitClass) -> RGBColor {
     match c {
         OrbitClass::Pendulum => RGBColor(31, 119, 180),
         OrbitClass::Bouncing => RGBColor(255, 157, 40),
@@ -463,16 +466,23 @@ const ALL_CLASSES: [OrbitClass; 5] = [
 
 /// A legend entry's mark.
 #[derive(Clone, Copy)]
-enum Mark {
+pub(crate) enum Mark {
     Swatch(RGBColor),
     Hatch(bool),
     Failed,
     Line(RGBColor),
     Dashed(RGBColor),
     Dot(RGBColor),
-    Band,
-    Arrow,
-    Diamond,
+    /// An open triangle pointing up: "no whirl up to the range top".
+    TriangleUp(RGBColor),
+    /// A translucent filled box: a probability band.
+    Fill(RGBColor),
+    /// An upward arrow in a colour.
+    ArrowUp(RGBColor),
+    /// A downward arrow in a colour.
+    ArrowDown(RGBColor),
+    /// An open circle.
+    OpenDot(RGBColor),
 }
 
 /// Draws hatch lines (45 degrees; the other diagonal if `forward`) in a pixel rectangle.
@@ -522,7 +532,7 @@ fn cross<DB: DrawingBackend>(
     ))
 }
 
-fn arrow<DB: DrawingBackend>(
+pub(crate) fn arrow<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     (x, y): (i32, i32),
     up: bool,
@@ -539,8 +549,20 @@ fn arrow<DB: DrawingBackend>(
     ))
 }
 
+/// Draws an open triangle pointing up, centred at `(x, y)`, of half-size `r` px.
+pub(crate) fn triangle_up<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x, y): (i32, i32),
+    r: i32,
+    colour: RGBColor,
+) -> DrawResult<DB> {
+    let pts = vec![(x - r, y + r), (x + r, y + r), (x, y - r), (x - r, y + r)];
+    area.draw(&Polygon::new(pts.clone(), WHITE.filled()))?;
+    area.draw(&PathElement::new(pts, colour.stroke_width(2)))
+}
+
 /// Draws a legend centred in `area`: one row, or more if the entries do not fit its width.
-fn legend<DB: DrawingBackend>(
+pub(crate) fn legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[(Mark, String)],
 ) -> DrawResult<DB> {
@@ -626,21 +648,20 @@ fn draw_mark<DB: DrawingBackend>(
             area.draw(&Circle::new((x + mark_w / 2, y), 6, c.filled()))?;
             area.draw(&Circle::new((x + mark_w / 2, y), 6, WHITE.stroke_width(1)))?;
         }
-        Mark::Band => {
+        Mark::TriangleUp(c) => triangle_up(area, (x + mark_w / 2, y), 7, c)?,
+        Mark::ArrowUp(c) => arrow(area, (x + mark_w / 2, y + 9), true, c)?,
+        Mark::ArrowDown(c) => arrow(area, (x + mark_w / 2, y - 9), false, c)?,
+        Mark::OpenDot(c) => {
+            area.draw(&Circle::new((x + mark_w / 2, y), 5, WHITE.filled()))?;
+            area.draw(&Circle::new((x + mark_w / 2, y), 5, c.stroke_width(2)))?;
+        }
+        Mark::Fill(c) => {
             area.draw(&Rectangle::new(
                 [(bx0, by0), (bx1, by1)],
-                BAND.mix(0.22).filled(),
+                c.mix(0.25).filled(),
             ))?;
-            area.draw(&PathElement::new(
-                vec![(x + mark_w / 2, by0), (x + mark_w / 2, by1)],
-                BAND.stroke_width(3),
-            ))?;
+            area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], c.stroke_width(1)))?;
         }
-        Mark::Arrow => arrow(area, (x + mark_w / 2, y + 9), true, RGBColor(60, 60, 60))?,
-        Mark::Diamond => area.draw(&Polygon::new(
-            vec![(x + 13, y - 7), (x + 20, y), (x + 13, y + 7), (x + 6, y)],
-            RGBColor(60, 60, 60).filled(),
-        ))?,
     }
     Ok(())
 }
@@ -648,7 +669,7 @@ fn draw_mark<DB: DrawingBackend>(
 /// Largest magnitude drawn: beyond it values are clamped, so spans stay finite.
 const VALUE_LIMIT: f64 = 1e300;
 
-fn clamp_value(v: f64) -> f64 {
+pub(crate) fn clamp_value(v: f64) -> f64 {
     v.clamp(-VALUE_LIMIT, VALUE_LIMIT)
 }
 
@@ -692,7 +713,7 @@ fn with_slice(title: &str, slice: &Option<String>) -> String {
 }
 
 /// Draws `text` with a white box behind it, centred at pixel `(x, y)` of `area`.
-fn boxed_text<DB: DrawingBackend>(
+pub(crate) fn boxed_text<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     text: &str,
     (x, y): (i32, i32),
@@ -1015,41 +1036,12 @@ fn draw_colour_bar<DB: DrawingBackend>(
 }
 
 // ---------------------------------------------------------------------------------------------
-// Fig. 4: critical whirl speed against friction.
+// Fig. 4's inputs (the figure is in `crate::fig4`).
 
-/// One friction coefficient's critical-speed search, from `critical.json`.
-#[derive(Debug, Clone, Deserialize)]
-pub struct CriticalEntry {
-    /// Friction coefficient.
-    pub mu: f64,
-    /// What the search found.
-    pub result: CriticalResult,
-}
-
-/// A critical-speed search result (the fields the chart uses; others are ignored).
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(default)]
-pub struct CriticalResult {
-    /// The speeds (r/min) bracketing the onset of whirl, or `None` if no transition was
-    /// found within the scanned range.
-    pub bracket: Option<[f64; 2]>,
-    /// Class at the low end.
-    pub class_lo: Option<Value>,
-    /// Class at the high end.
-    pub class_hi: Option<Value>,
-    /// Drops the search ran.
-    pub drops_used: Option<u64>,
-    /// Whether the scan was not monotone (whirl, then no whirl, at higher speed).
-    pub non_monotone: bool,
-    /// Scanned (speed r/min, class) pairs.
-    pub scanned: Vec<(f64, Value)>,
-    /// Free-text remark.
-    pub note: Option<String>,
-}
-
-/// Reads `dir/critical.json`, or `None` if it does not exist.
-pub fn load_critical(dir: &Path) -> Result<Option<Vec<CriticalEntry>>, ChartError> {
-    let path = dir.join("critical.json");
+/// Reads and parses the JSON file `path`, or `None` if it does not exist.
+fn read_optional_json<T: serde::de::DeserializeOwned>(
+    path: PathBuf,
+) -> Result<Option<T>, ChartError> {
     let text = match std::fs::read_to_string(&path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
@@ -1064,256 +1056,18 @@ pub fn load_critical(dir: &Path) -> Result<Option<Vec<CriticalEntry>>, ChartErro
         })
 }
 
-fn is_whirl_value(v: &Value) -> Option<bool> {
-    serde_json::from_value::<OrbitClass>(v.clone())
-        .ok()
-        .map(OrbitClass::is_whirl)
+/// Reads `dir/critical.json` (a list of [`CriticalRow`]), or `None` if it does not exist.
+pub fn load_critical(dir: &Path) -> Result<Option<Vec<CriticalRow>>, ChartError> {
+    read_optional_json(dir.join(crate::extras::CRITICAL_FILE))
 }
 
-/// Where the onset lies when no bracket was found: `Some(true)` above the scanned range
-/// (no whirl anywhere), `Some(false)` below it (whirl everywhere), `None` if undecided.
-fn no_transition_side(r: &CriticalResult) -> Option<bool> {
-    let whirls: Vec<bool> = r
-        .scanned
-        .iter()
-        .filter_map(|(_, c)| is_whirl_value(c))
-        .collect();
-    if !whirls.is_empty() {
-        if whirls.iter().all(|w| !w) {
-            return Some(true);
-        }
-        if whirls.iter().all(|w| *w) {
-            return Some(false);
-        }
-        return None;
-    }
-    let lo = r.class_lo.as_ref().and_then(is_whirl_value);
-    let hi = r.class_hi.as_ref().and_then(is_whirl_value);
-    match (lo, hi) {
-        (_, Some(false)) => Some(true),
-        (Some(true), _) => Some(false),
-        _ => None,
-    }
-}
-
-struct CriticalFigure<'a> {
-    entries: &'a [CriticalEntry],
-    grid: &'a Grid,
-    title: String,
-}
-
-impl Figure for CriticalFigure<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let mut entries: Vec<CriticalEntry> = self
-            .entries
-            .iter()
-            .filter(|e| e.mu.is_finite())
-            .cloned()
-            .map(|mut e| {
-                e.mu = clamp_value(e.mu);
-                let r = &mut e.result;
-                r.bracket = r.bracket.map(|b| b.map(clamp_value));
-                r.scanned.iter_mut().for_each(|s| s.0 = clamp_value(s.0));
-                e
-            })
-            .collect();
-        entries.sort_by(|a, b| a.mu.total_cmp(&b.mu));
-        let points: Vec<(f64, f64, &PointRow)> = self
-            .grid
-            .rows
-            .iter()
-            .filter_map(|r| Some((clamp_value(r.mu()?), clamp_value(r.speed_rpm()?), r)))
-            .collect();
-
-        let mus = entries
-            .iter()
-            .map(|e| e.mu)
-            .chain(points.iter().map(|p| p.0));
-        let speeds = entries
-            .iter()
-            .flat_map(|e| {
-                e.result
-                    .bracket
-                    .into_iter()
-                    .flatten()
-                    .chain(e.result.scanned.iter().map(|s| s.0))
-            })
-            .chain(points.iter().map(|p| p.1));
-        let bounds = |v: Vec<f64>| {
-            v.into_iter()
-                .filter(|x| x.is_finite())
-                .fold(None, |acc: Option<(f64, f64)>, x| {
-                    Some(acc.map_or((x, x), |(lo, hi)| (lo.min(x), hi.max(x))))
-                })
-        };
-        let pad = |b: Option<(f64, f64)>, f: f64| match b {
-            None => (0.0, 1.0),
-            Some((lo, hi)) if hi > lo => (lo - (hi - lo) * f, hi + (hi - lo) * f),
-            Some((lo, _)) => (lo - lo.abs().max(1.0) * 0.1, lo + lo.abs().max(1.0) * 0.1),
-        };
-        let (x0, x1) = pad(bounds(mus.collect()), 0.1);
-        let (y0, y1) = pad(bounds(speeds.collect()), 0.15);
-        // Range ends for the "no transition" markers: the scanned range, else the grid's.
-        let grid_speed = bounds(points.iter().map(|p| p.1).collect());
-
-        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
-        let (_, bh) = body.dim_in_pixel();
-        let (plot_area, legend_band) = body.split_vertically(bh.saturating_sub(60));
-        let mut chart = ChartBuilder::on(&plot_area)
-            .margin_top(12)
-            .margin_left(14)
-            .margin_right(34)
-            .margin_bottom(4)
-            .x_label_area_size(X_LABEL_AREA)
-            .y_label_area_size(Y_LABEL_AREA)
-            .build_cartesian_2d(x0..x1, y0..y1)?;
-        chart_mesh(&mut chart, MU_DESC, "critical whirl speed (r/min)", 10, 8)?;
-
-        // The bracket band, over runs of neighbouring mu values that all have a bracket.
-        let mut run: Vec<(f64, f64, f64)> = Vec::new();
-        let mut runs = Vec::new();
-        for e in &entries {
-            match e.result.bracket {
-                Some([lo, hi]) if lo.is_finite() && hi.is_finite() => {
-                    run.push((e.mu, lo.min(hi), lo.max(hi)))
-                }
-                _ => runs.push(std::mem::take(&mut run)),
-            }
-        }
-        runs.push(run);
-        for run in runs.iter().filter(|r| r.len() >= 2) {
-            let poly: Vec<(f64, f64)> = run
-                .iter()
-                .map(|p| (p.0, p.1))
-                .chain(run.iter().rev().map(|p| (p.0, p.2)))
-                .collect();
-            chart.draw_series([Polygon::new(poly, BAND.mix(0.18).filled())])?;
-            chart.draw_series([
-                PathElement::new(
-                    run.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>(),
-                    BAND.mix(0.6).stroke_width(1),
-                ),
-                PathElement::new(
-                    run.iter().map(|p| (p.0, p.2)).collect::<Vec<_>>(),
-                    BAND.mix(0.6).stroke_width(1),
-                ),
-            ])?;
-        }
-
-        // Grid points, coloured by class.
-        let pa = chart.plotting_area();
-        let base = pa.get_base_pixel();
-        let px = |x: f64, y: f64| {
-            let p = chart.backend_coord(&(x, y));
-            (p.0 - base.0, p.1 - base.1)
-        };
-        let canvas = pa.strip_coord_spec();
-        let mut classes_seen = Vec::new();
-        let mut any_failed = false;
-        for (mu, speed, row) in &points {
-            let p = px(*mu, *speed);
-            match (row.status, row.class) {
-                (PointStatus::Ok, Some(c)) => {
-                    if !classes_seen.contains(&c) {
-                        classes_seen.push(c);
-                    }
-                    canvas.draw(&Circle::new(p, 6, class_colour(c).filled()))?;
-                    canvas.draw(&Circle::new(p, 6, WHITE.stroke_width(1)))?;
-                }
-                _ => {
-                    any_failed = true;
-                    cross(&canvas, p, 5)?;
-                }
-            }
-        }
-
-        // Brackets as error bars; no-transition markers at the range end.
-        let (mut any_arrow, mut any_nonmono) = (false, false);
-        for e in &entries {
-            let r = &e.result;
-            if let Some([lo, hi]) = r.bracket.filter(|b| b[0].is_finite() && b[1].is_finite()) {
-                let (a, b) = (px(e.mu, lo.min(hi)), px(e.mu, lo.max(hi)));
-                let style = BAND.stroke_width(3);
-                canvas.draw(&PathElement::new(vec![a, b], style))?;
-                canvas.draw(&PathElement::new(
-                    vec![(a.0 - 7, a.1), (a.0 + 7, a.1)],
-                    style,
-                ))?;
-                canvas.draw(&PathElement::new(
-                    vec![(b.0 - 7, b.1), (b.0 + 7, b.1)],
-                    style,
-                ))?;
-                if r.non_monotone {
-                    any_nonmono = true;
-                    let (x, y) = ((a.0 + b.0) / 2 + 14, (a.1 + b.1) / 2);
-                    canvas.draw(&Polygon::new(
-                        vec![(x, y - 7), (x + 7, y), (x, y + 7), (x - 7, y)],
-                        RGBColor(60, 60, 60).filled(),
-                    ))?;
-                }
-                continue;
-            }
-            let scanned = bounds(r.scanned.iter().map(|s| s.0).collect()).or(grid_speed);
-            let (Some(side), Some((s_lo, s_hi))) = (no_transition_side(r), scanned) else {
-                continue;
-            };
-            any_arrow = true;
-            let colour = RGBColor(60, 60, 60);
-            let style = chart_text_style(13.0).color(&colour);
-            if side {
-                let p = px(e.mu, s_hi);
-                arrow(&canvas, p, true, colour)?;
-                let text = format!("no whirl up to {} r/min", chart_quantity(s_hi));
-                canvas.draw_text(
-                    &text,
-                    &style.pos(Pos::new(HPos::Center, VPos::Bottom)),
-                    (p.0, p.1 - 24),
-                )?;
-            } else {
-                let p = px(e.mu, s_lo);
-                arrow(&canvas, p, false, colour)?;
-                let text = format!("whirl from {} r/min", chart_quantity(s_lo));
-                canvas.draw_text(
-                    &text,
-                    &style.pos(Pos::new(HPos::Center, VPos::Top)),
-                    (p.0, p.1 + 24),
-                )?;
-            }
-        }
-
-        // Region labels.
-        let (w, h) = canvas.dim_in_pixel();
-        let (w, h) = (w as i32, h as i32);
-        boxed_text(
-            &canvas,
-            "backward whirl",
-            (w / 2, (h as f64 * 0.04) as i32 + 8),
-            CAPTION_FONT,
-            class_colour(OrbitClass::BackwardWhirl),
-        )?;
-        boxed_text(
-            &canvas,
-            "pendulum vibration",
-            (w / 2, h - (h as f64 * 0.04) as i32 - 8),
-            CAPTION_FONT,
-            class_colour(OrbitClass::Pendulum),
-        )?;
-
-        let mut legend_entries = vec![(Mark::Band, "critical-speed bracket".to_string())];
-        for c in ALL_CLASSES.iter().filter(|c| classes_seen.contains(c)) {
-            legend_entries.push((Mark::Dot(class_colour(*c)), c.label().to_string()));
-        }
-        if any_failed {
-            legend_entries.push((Mark::Failed, "failed".to_string()));
-        }
-        if any_arrow {
-            legend_entries.push((Mark::Arrow, "no transition in range".to_string()));
-        }
-        if any_nonmono {
-            legend_entries.push((Mark::Diamond, "non-monotone scan".to_string()));
-        }
-        legend(&legend_band, &legend_entries)
-    }
+/// Reads the probability ensemble's `contours.json` of a sweep (`dir/probability/`), or
+/// `None` if the sweep ran none.
+pub fn load_probability(dir: &Path) -> Result<Option<ContoursFile>, ChartError> {
+    read_optional_json(
+        dir.join(crate::extras::PROBABILITY_DIR)
+            .join(crate::ensemble::CONTOURS_FILE),
+    )
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1453,7 +1207,7 @@ impl Figure for OrbitPanels<'_> {
 // ---------------------------------------------------------------------------------------------
 // Entry point.
 
-fn write_both<F: Figure>(
+pub(crate) fn write_both<F: Figure>(
     out_dir: &Path,
     stem: &str,
     size: (u32, u32),
@@ -1547,11 +1301,25 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
             &mut written,
         )?;
     }
-    if let Some(entries) = &critical {
-        let fig4 = CriticalFigure {
-            entries,
-            grid: &grid,
-            title: with_slice("Fig. 4: critical speed of backward whirl", &grid.slice),
+    if let Some(rows) = &critical {
+        let probability = load_probability(dir)?;
+        let band = probability.as_ref().map(band_points);
+        let label = probability.as_ref().map(|c| {
+            let top = c
+                .groups
+                .iter()
+                .filter_map(|g| g.speeds_rpm.last().copied())
+                .fold(0.0, f64::max);
+            format!(
+                "over release conditions ({} drops per cell, up to {} r/min)",
+                c.members,
+                chart_quantity(top)
+            )
+        });
+        let fig4 = Fig4 {
+            rows,
+            band: band.as_deref().zip(label),
+            title: "Fig. 4: critical speed of backward whirl".to_string(),
         };
         write_both(&out_dir, "fig4_critical", CHART_SIZE, &fig4, &mut written)?;
     }

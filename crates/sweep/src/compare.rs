@@ -14,9 +14,10 @@
 //! of the new run whose changed cells are outlined.
 
 use crate::charts::{
-    assemble_grid, draw_marked_class_map, load_critical, load_points, ChartError, CriticalEntry,
-    PointRow, PointStatus,
+    assemble_grid, draw_marked_class_map, load_critical, load_points, ChartError, PointRow,
+    PointStatus,
 };
+use crate::critical::CriticalRow;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -204,10 +205,10 @@ fn fmt_bracket(b: Option<[f64; 2]>) -> String {
     })
 }
 
-fn compare_critical(base: &[CriticalEntry], new: &[CriticalEntry]) -> (usize, Vec<CriticalChange>) {
+fn compare_critical(base: &[CriticalRow], new: &[CriticalRow]) -> (usize, Vec<CriticalChange>) {
     let mut changes = Vec::new();
     let mut compared = 0;
-    let find = |list: &[CriticalEntry], mu: f64| {
+    let find = |list: &[CriticalRow], mu: f64| {
         list.iter()
             .find(|e| (e.mu - mu).abs() <= 1e-12 * mu.abs().max(1.0))
             .cloned()
@@ -217,22 +218,34 @@ fn compare_critical(base: &[CriticalEntry], new: &[CriticalEntry]) -> (usize, Ve
             changes.push(CriticalChange {
                 mu: n.mu,
                 baseline: None,
-                new: n.result.bracket,
+                new: n.bracket_rpm,
                 what: "searched in the new run only".into(),
             });
             continue;
         };
         compared += 1;
-        let (bb, nb) = (b.result.bracket, n.result.bracket);
-        let what = match (bb, nb) {
+        let (bb, nb) = (b.bracket_rpm, n.bracket_rpm);
+        let mut what = match (bb, nb) {
             (Some([blo, bhi]), Some([nlo, nhi])) if nhi < blo || nlo > bhi => Some(format!(
-                "moved {} (brackets do not overlap)",
+                "onset moved {} (brackets do not overlap)",
                 if nlo > bhi { "up" } else { "down" }
             )),
-            (Some(_), Some(_)) | (None, None) => None,
-            (Some(_), None) => Some("transition no longer found".into()),
-            (None, Some(_)) => Some("transition found, none before".into()),
+            _ => None,
         };
+        if what.is_none() && b.onset_rpm.is_some() != n.onset_rpm.is_some() {
+            what = Some(if n.onset_rpm.is_some() {
+                "whirl found, none before".into()
+            } else {
+                "whirl no longer found".into()
+            });
+        }
+        if what.is_none() && b.whirl_intervals_rpm.len() != n.whirl_intervals_rpm.len() {
+            what = Some(format!(
+                "whirl intervals {} -> {}",
+                b.whirl_intervals_rpm.len(),
+                n.whirl_intervals_rpm.len()
+            ));
+        }
         if let Some(what) = what {
             changes.push(CriticalChange {
                 mu: n.mu,
@@ -246,7 +259,7 @@ fn compare_critical(base: &[CriticalEntry], new: &[CriticalEntry]) -> (usize, Ve
         if find(new, b.mu).is_none() {
             changes.push(CriticalChange {
                 mu: b.mu,
-                baseline: b.result.bracket,
+                baseline: b.bracket_rpm,
                 new: None,
                 what: "searched in the baseline only".into(),
             });
@@ -424,7 +437,7 @@ pub fn write_report(c: &Comparison, path: &Path) -> Result<PathBuf, ChartError> 
             if c.critical_compared == 0 {
                 "No critical-speed search to compare."
             } else {
-                "No critical speed moved beyond its brackets."
+                "No critical speed moved beyond its brackets, and every friction coefficient has as many whirl intervals as before."
             }
         );
     } else {
@@ -466,14 +479,20 @@ mod tests {
         assert!(rel_change("f", "N", Some(1.0), None, 0.05).is_some());
     }
 
-    fn entry(mu: f64, bracket: Option<[f64; 2]>) -> CriticalEntry {
-        CriticalEntry {
-            mu,
-            result: crate::charts::CriticalResult {
-                bracket,
-                ..Default::default()
-            },
+    fn entry(mu: f64, bracket: Option<[f64; 2]>) -> CriticalRow {
+        crate::critical::SearchResult {
+            onset_rpm: bracket.map(|b| b[1]),
+            bracket_rpm: bracket,
+            class_below: None,
+            class_above: None,
+            whirl_intervals_rpm: bracket.map(|b| vec![[b[1], 30000.0]]).unwrap_or_default(),
+            whirl_at_range_top: bracket.is_some(),
+            converged: true,
+            scan: Vec::new(),
+            bisections: Vec::new(),
+            note: String::new(),
         }
+        .into_row(mu, &Default::default(), String::new())
     }
 
     #[test]
@@ -501,6 +520,7 @@ mod tests {
         );
         assert_eq!(ch.len(), 2);
         assert!(ch[0].what.contains("moved up"), "{:?}", ch[0]);
+        assert!(ch[1].what.contains("whirl found"), "{:?}", ch[1]);
         assert!(ch[1].what.contains("found"), "{:?}", ch[1]);
         // A mu searched only in one run.
         let (n, ch) = compare_critical(&base, &[entry(0.3, Some([4000.0, 4500.0]))]);

@@ -1,26 +1,47 @@
-//! The critical backward-whirl speed: the lowest release speed at which a drop whirls, for
-//! a given friction coefficient.
+//! The critical backward-whirl speed: for each friction coefficient, the lowest release speed
+//! at which a drop settles into sustained whirl (the designer's "safe below" speed), and every
+//! speed interval where it does.
 //!
-//! [`search`] is a pure search over any class predicate (testable without the integrator):
-//! a coarse uniform scan (in parallel, order- and thread-count-independent) finds the
-//! LOWEST non-whirl-to-whirl transition between adjacent successful scan points, then a
-//! bisection narrows it to `tol_rpm`. Nothing assumes the boundary is monotone: a whirl
-//! point seen below a non-whirl point at a higher speed sets
-//! [`CriticalResult::non_monotone`]. When no transition lies in the range (no whirl at all,
-//! or whirl already at the lowest speed) the bracket is `None` and the note says which; no
-//! number is invented. Failed drops (solver errors) are listed in
-//! [`CriticalResult::failures`] and count as neither class.
+//! ## The search
+//! 1. **Scan on an absolute speed lattice**: every multiple of `resolution_rpm` in
+//!    `[from_rpm, to_rpm]`, plus the two range ends. The lattice is aligned to multiples of
+//!    the resolution, not to the range ends, so two searches over different ranges drop the
+//!    same speeds where their ranges overlap. The scans of all friction coefficients run as
+//!    one parallel batch.
+//! 2. **Every class transition** between neighbouring successful scan points (whirl on one
+//!    side, no whirl on the other) is **bisected** to `tol_rpm`; the bisections of all
+//!    transitions of all friction coefficients run in parallel.
+//! 3. **Report** per friction coefficient a [`CriticalRow`]: the onset (the whirl side of the
+//!    lowest transition into whirl; the lowest scan speed when the range already whirls
+//!    there), its bracket and the classes on each side, every whirl interval found, and
+//!    `non_monotone` exactly when there is more than one interval.
 //!
-//! [`critical_speeds`] runs the search with the real model for several friction
-//! coefficients (in parallel; results are deterministic whatever the thread count).
+//! Two searches whose ranges both start below the onset and contain it find the same lowest
+//! transition between the same lattice points and bisect it identically, so they give the same
+//! onset (within `tol_rpm` when a range end falls inside that lattice cell). The lattice is
+//! the resolution floor: a whirl interval narrower than one lattice step can be missed.
+//!
+//! Failed drops (solver errors, panics) count as neither class and are listed; `unresolved`
+//! drops count as no whirl, and the note says so. [`search`] is a pure function of any class
+//! predicate, testable without the integrator.
 
-use crate::classify::{classify, ClassifyParams, OrbitClass};
+use crate::classify::OrbitClass;
+use crate::recheck::Recheck;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use whirlmap_core::{simulate, DropOptions, InvalidParameter, Scene};
+use whirlmap_core::{simulate, DropOptions, InvalidParameter, Scene, MODEL_VERSION};
 
-/// Scan points of the coarse scan when not told otherwise.
-pub const DEFAULT_SCAN_POINTS: usize = 12;
+/// Default lattice step of the scan (r/min).
+pub const DEFAULT_RESOLUTION_RPM: f64 = 250.0;
+
+/// Default bisection tolerance (r/min).
+pub const DEFAULT_TOL_RPM: f64 = 25.0;
+
+/// Most scan points one search may need (range / resolution).
+pub const MAX_SCAN_POINTS: f64 = 10_000.0;
+
+/// Highest speed a search may reach (r/min): the scene's speed limit.
+pub const MAX_SPEED_RPM: f64 = 1e6;
 
 /// Bisection steps at most (a guard: floats stop halving long before this).
 const MAX_BISECTIONS: usize = 200;
@@ -39,322 +60,424 @@ pub enum Outcome {
     Failed(String),
 }
 
-/// A drop that failed during the search.
+impl Outcome {
+    /// Whether the drop whirled; `None` when it failed.
+    pub fn whirl(&self) -> Option<bool> {
+        match self {
+            Outcome::Class(c) => Some(c.is_whirl()),
+            Outcome::Failed(_) => None,
+        }
+    }
+}
+
+/// One drop of a search: its speed and what it gave.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct FailedDrop {
-    /// Release speed of the drop (r/min).
+pub struct Probe {
+    /// Release speed (r/min).
     pub speed_rpm: f64,
-    /// Why it failed.
-    pub error: String,
+    /// The class, when the drop finished.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub class: Option<OrbitClass>,
+    /// The failure, when it did not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
 }
 
-/// The result of one critical-speed search.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CriticalResult {
-    /// `(lo, hi)` r/min: no whirl at `lo`, whirl at `hi`, the lowest such transition found.
-    /// `None` when the range holds no transition (see `note`).
-    pub bracket: Option<(f64, f64)>,
-    /// Class at `lo` (pendulum, bouncing or unresolved); `None` without a bracket.
-    pub class_lo: Option<OrbitClass>,
-    /// Class at `hi` (backward or forward whirl); `None` without a bracket.
-    pub class_hi: Option<OrbitClass>,
-    /// Whether the bracket is no wider than the tolerance (false if a bisection drop failed).
-    pub converged: bool,
-    /// Drops run (scan plus bisection, failed ones included).
-    pub drops_used: usize,
-    /// A whirl point was seen below a non-whirl point at a higher speed (scan or bisection).
-    pub non_monotone: bool,
-    /// The coarse scan, in speed order (failed drops left out: see `failures`).
-    pub scanned: Vec<(f64, OrbitClass)>,
-    /// The bisection drops, in the order run (failed ones left out).
-    pub bisected: Vec<(f64, OrbitClass)>,
-    /// Drops that failed, in the order run (scan first, in speed order).
-    pub failures: Vec<FailedDrop>,
-    /// What was found, in words.
-    pub note: String,
+impl Probe {
+    fn new(speed_rpm: f64, o: &Outcome) -> Self {
+        match o {
+            Outcome::Class(c) => Self {
+                speed_rpm,
+                class: Some(*c),
+                error: None,
+            },
+            Outcome::Failed(e) => Self {
+                speed_rpm,
+                class: None,
+                error: Some(e.clone()),
+            },
+        }
+    }
 }
 
-/// Settings of a critical-speed search with the real model.
+/// Settings of a critical-speed search.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(deny_unknown_fields)]
 pub struct CriticalOptions {
-    /// Lowest release speed searched (r/min), >= 0.
+    /// Lowest release speed searched (r/min), in [0, 1e6).
     pub from_rpm: f64,
-    /// Highest release speed searched (r/min), > `from_rpm`.
+    /// Highest release speed searched (r/min), in (`from_rpm`, 1e6].
     pub to_rpm: f64,
-    /// Bracket width to stop bisecting at (r/min), > 0.
+    /// Lattice step of the scan (r/min), in [1, 1e5]. Default 250.
+    pub resolution_rpm: f64,
+    /// Bracket width to stop bisecting at (r/min), in [0.01, `resolution_rpm`]. Default 25.
     pub tol_rpm: f64,
-    /// Points of the coarse scan, >= 2.
-    pub scan_points: usize,
-    /// Simulated time of each drop (s).
+    /// Simulated time of each drop (s), before any extension the classifier asks for.
     pub duration_s: f64,
-    /// Classifier thresholds.
-    pub classify: ClassifyParams,
 }
 
 impl Default for CriticalOptions {
     fn default() -> Self {
         Self {
-            from_rpm: 2000.0,
+            from_rpm: 1000.0,
             to_rpm: 30_000.0,
-            tol_rpm: 50.0,
-            scan_points: DEFAULT_SCAN_POINTS,
+            resolution_rpm: DEFAULT_RESOLUTION_RPM,
+            tol_rpm: DEFAULT_TOL_RPM,
             duration_s: 1.0,
-            classify: ClassifyParams::default(),
         }
     }
 }
 
 impl CriticalOptions {
-    /// Checks the search settings; the error names the field.
+    /// Checks the settings before any drop runs; the error names the field, its value and
+    /// the allowed range.
     pub fn validate(&self) -> Result<(), InvalidParameter> {
-        check_range(self.from_rpm, self.to_rpm, self.tol_rpm)?;
-        if self.scan_points < 2 || self.scan_points > 100_000 {
-            return Err(InvalidParameter::new(
-                "scan_points",
-                self.scan_points,
-                "[2, 100000]",
-            ));
-        }
+        check_range(
+            self.from_rpm,
+            self.to_rpm,
+            self.resolution_rpm,
+            self.tol_rpm,
+        )?;
         DropOptions {
             duration_s: self.duration_s,
             ..Default::default()
         }
         .validate()
     }
+
+    /// The scan speeds: every multiple of the resolution in `[from, to]` and both ends, in
+    /// increasing order.
+    pub fn scan_speeds(&self) -> Vec<f64> {
+        let r = self.resolution_rpm;
+        let mut v = vec![self.from_rpm];
+        let mut k = (self.from_rpm / r).floor() + 1.0;
+        while k * r < self.to_rpm {
+            v.push(k * r);
+            k += 1.0;
+        }
+        v.push(self.to_rpm);
+        v.dedup();
+        v
+    }
 }
 
-/// Checks a search range: `from_rpm` and `to_rpm` finite, >= 0, `from_rpm < to_rpm`;
-/// `tol_rpm` finite and > 0. The error names the field.
-pub fn check_range(from_rpm: f64, to_rpm: f64, tol_rpm: f64) -> Result<(), InvalidParameter> {
-    if !(from_rpm.is_finite() && from_rpm >= 0.0) {
-        return Err(InvalidParameter::new("from_rpm", from_rpm, ">= 0, finite"));
+/// Checks a search range: `from_rpm` in [0, 1e6), `to_rpm` in (`from_rpm`, 1e6],
+/// `resolution_rpm` in [1, 1e5] with at most 10 000 lattice steps in the range, and `tol_rpm`
+/// in [0.01, `resolution_rpm`]. The error names the field.
+pub fn check_range(
+    from_rpm: f64,
+    to_rpm: f64,
+    resolution_rpm: f64,
+    tol_rpm: f64,
+) -> Result<(), InvalidParameter> {
+    if !(from_rpm.is_finite() && (0.0..MAX_SPEED_RPM).contains(&from_rpm)) {
+        return Err(InvalidParameter::new(
+            "from_rpm",
+            from_rpm,
+            "[0, 1e6) r/min",
+        ));
     }
-    if !(to_rpm.is_finite() && to_rpm >= 0.0) {
-        return Err(InvalidParameter::new("to_rpm", to_rpm, ">= 0, finite"));
-    }
-    if from_rpm >= to_rpm {
+    if !(to_rpm.is_finite() && to_rpm > from_rpm && to_rpm <= MAX_SPEED_RPM) {
         return Err(InvalidParameter::new(
             "to_rpm",
             to_rpm,
-            &format!("> {from_rpm} (the lower end)"),
+            &format!("({from_rpm}, 1e6] r/min (above from_rpm)"),
         ));
     }
-    if !(tol_rpm.is_finite() && tol_rpm > 0.0) {
-        return Err(InvalidParameter::new("tol_rpm", tol_rpm, "> 0, finite"));
+    if !(resolution_rpm.is_finite() && (1.0..=1e5).contains(&resolution_rpm)) {
+        return Err(InvalidParameter::new(
+            "resolution_rpm",
+            resolution_rpm,
+            "[1, 1e5] r/min",
+        ));
+    }
+    if !((to_rpm - from_rpm) / resolution_rpm <= MAX_SCAN_POINTS) {
+        return Err(InvalidParameter::new(
+            "resolution_rpm",
+            resolution_rpm,
+            &format!(
+                ">= {} r/min for this range (at most 10000 scan points)",
+                (to_rpm - from_rpm) / MAX_SCAN_POINTS
+            ),
+        ));
+    }
+    if !(tol_rpm.is_finite() && tol_rpm >= 0.01 && tol_rpm <= resolution_rpm) {
+        return Err(InvalidParameter::new(
+            "tol_rpm",
+            tol_rpm,
+            &format!("[0.01, {resolution_rpm}] r/min (at most the resolution)"),
+        ));
     }
     Ok(())
 }
 
-/// Checks a list of friction coefficients: not empty, each in [0, 2].
+/// Checks a list of friction coefficients: not empty, each in [0, 2], no value twice.
 pub fn check_mus(mus: &[f64]) -> Result<(), InvalidParameter> {
     if mus.is_empty() {
         return Err(InvalidParameter::new("mu", "(none)", "at least one value"));
     }
-    for &mu in mus {
+    for (i, &mu) in mus.iter().enumerate() {
         if !(mu.is_finite() && (0.0..=2.0).contains(&mu)) {
             return Err(InvalidParameter::new("mu", mu, "[0, 2]"));
+        }
+        if mus[..i].contains(&mu) {
+            return Err(InvalidParameter::new("mu", mu, "each value once"));
         }
     }
     Ok(())
 }
 
-/// Speeds of the coarse scan: `n` uniform points from `from` to `to`, both included.
-fn scan_speeds(from: f64, to: f64, n: usize) -> Vec<f64> {
-    let n = n.max(2);
-    (0..n)
-        .map(|i| {
-            if i + 1 == n {
-                to
-            } else {
-                from + (to - from) * i as f64 / (n - 1) as f64
-            }
-        })
-        .collect()
+/// One friction coefficient's result: the row of `critical.json`, of
+/// `whirlmap critical --json` and (its scalar fields) of `critical.csv`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CriticalRow {
+    /// Friction coefficient (`mu_dynamic`).
+    pub mu: f64,
+    /// The lowest speed at which sustained whirl was found (r/min): the whirl side of the
+    /// lowest transition into whirl, or the lowest scan speed when the range already whirls
+    /// there (then `bracket_rpm` is null). Null when the range holds no whirl (`note` says
+    /// so).
+    pub onset_rpm: Option<f64>,
+    /// `[below, above]` (r/min): no whirl at `below`, whirl at `above`, at most `tol_rpm`
+    /// apart when converged. Null without a transition into whirl.
+    pub bracket_rpm: Option<[f64; 2]>,
+    /// Class at the bracket's lower end.
+    pub class_below: Option<OrbitClass>,
+    /// Class at the bracket's upper end.
+    pub class_above: Option<OrbitClass>,
+    /// Every speed interval `[first, last]` with whirl (r/min), in increasing speed: from
+    /// the whirl side of a transition into whirl (or the lowest scan speed) to the whirl side
+    /// of the transition out of it (or the range top). Gaps above the onset are where the map
+    /// is not monotone.
+    pub whirl_intervals_rpm: Vec<[f64; 2]>,
+    /// The last interval runs to the top of the range (whirl at `to_rpm`).
+    pub whirl_at_range_top: bool,
+    /// More than one whirl interval.
+    pub non_monotone: bool,
+    /// Drops run (scan and bisections, failed ones included).
+    pub drops: usize,
+    /// Drops that failed (counted as neither class; see `scan` and `bisections`).
+    pub failed_drops: usize,
+    /// Every bisection reached `tol_rpm`.
+    pub converged: bool,
+    /// Lowest speed searched (r/min).
+    pub from_rpm: f64,
+    /// Highest speed searched (r/min).
+    pub to_rpm: f64,
+    /// Lattice step of the scan (r/min).
+    pub resolution_rpm: f64,
+    /// Bisection tolerance (r/min).
+    pub tol_rpm: f64,
+    /// Simulated time of each drop before extension (s).
+    pub duration_s: f64,
+    /// `Scene::hash_hex` of the searched scene (with this `mu`; the speed varies).
+    pub scene_hash: String,
+    /// `whirlmap_core::MODEL_VERSION`.
+    pub model_version: u32,
+    /// What was found, in words.
+    pub note: String,
+    /// The scan, in speed order.
+    pub scan: Vec<Probe>,
+    /// The bisection drops, transition by transition in speed order, each in the order run.
+    pub bisections: Vec<Probe>,
+    /// The onset bracket re-run at a tighter fidelity preset, when asked for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recheck: Option<Recheck>,
 }
 
-/// Whether a whirl point lies below a non-whirl point at a higher speed; returns the first
-/// such pair `(whirl speed, non-whirl speed)` in speed order.
-fn find_non_monotone(points: &[(f64, OrbitClass)]) -> Option<(f64, f64)> {
-    let mut sorted: Vec<(f64, OrbitClass)> = points.to_vec();
-    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut lowest_whirl: Option<f64> = None;
-    for &(s, c) in &sorted {
-        if c.is_whirl() {
-            lowest_whirl.get_or_insert(s);
-        } else if let Some(w) = lowest_whirl {
-            return Some((w, s));
+/// The header of `critical.csv`.
+pub const CSV_HEADER: &str = "mu,onset_rpm,bracket_below_rpm,bracket_above_rpm,class_below,class_above,whirl_intervals_rpm,whirl_at_range_top,non_monotone,drops,failed_drops,converged,from_rpm,to_rpm,resolution_rpm,tol_rpm,note";
+
+impl CriticalRow {
+    /// The row's line of `critical.csv` (see [`CSV_HEADER`]): intervals as
+    /// `first-last` separated by `;`, empty cells for nulls, the note quoted.
+    pub fn csv_line(&self) -> String {
+        let opt = |v: Option<f64>| v.map_or(String::new(), |x| x.to_string());
+        let class = |c: Option<OrbitClass>| c.map_or("", |c| c.name()).to_string();
+        let intervals = self
+            .whirl_intervals_rpm
+            .iter()
+            .map(|[a, b]| format!("{a}-{b}"))
+            .collect::<Vec<_>>()
+            .join(";");
+        [
+            self.mu.to_string(),
+            opt(self.onset_rpm),
+            opt(self.bracket_rpm.map(|b| b[0])),
+            opt(self.bracket_rpm.map(|b| b[1])),
+            class(self.class_below),
+            class(self.class_above),
+            intervals,
+            self.whirl_at_range_top.to_string(),
+            self.non_monotone.to_string(),
+            self.drops.to_string(),
+            self.failed_drops.to_string(),
+            self.converged.to_string(),
+            self.from_rpm.to_string(),
+            self.to_rpm.to_string(),
+            self.resolution_rpm.to_string(),
+            self.tol_rpm.to_string(),
+            format!("\"{}\"", self.note.replace('"', "'")),
+        ]
+        .join(",")
+    }
+}
+
+/// `critical.csv`'s text for `rows`: the header and one line per row.
+pub fn csv_text(rows: &[CriticalRow]) -> String {
+    let mut s = String::from(CSV_HEADER);
+    s.push('\n');
+    for r in rows {
+        s.push_str(&r.csv_line());
+        s.push('\n');
+    }
+    s
+}
+
+/// The speeds-and-classes part of a result, before the settings and hash are attached.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchResult {
+    /// See [`CriticalRow::onset_rpm`].
+    pub onset_rpm: Option<f64>,
+    /// See [`CriticalRow::bracket_rpm`].
+    pub bracket_rpm: Option<[f64; 2]>,
+    /// See [`CriticalRow::class_below`].
+    pub class_below: Option<OrbitClass>,
+    /// See [`CriticalRow::class_above`].
+    pub class_above: Option<OrbitClass>,
+    /// See [`CriticalRow::whirl_intervals_rpm`].
+    pub whirl_intervals_rpm: Vec<[f64; 2]>,
+    /// See [`CriticalRow::whirl_at_range_top`].
+    pub whirl_at_range_top: bool,
+    /// See [`CriticalRow::converged`].
+    pub converged: bool,
+    /// See [`CriticalRow::scan`].
+    pub scan: Vec<Probe>,
+    /// See [`CriticalRow::bisections`].
+    pub bisections: Vec<Probe>,
+    /// See [`CriticalRow::note`].
+    pub note: String,
+}
+
+impl SearchResult {
+    /// Drops run.
+    pub fn drops(&self) -> usize {
+        self.scan.len() + self.bisections.len()
+    }
+    /// Drops that failed.
+    pub fn failed_drops(&self) -> usize {
+        self.scan
+            .iter()
+            .chain(&self.bisections)
+            .filter(|p| p.error.is_some())
+            .count()
+    }
+    /// The full row for friction coefficient `mu` searched with `o` on a scene of hash
+    /// `scene_hash`.
+    pub fn into_row(self, mu: f64, o: &CriticalOptions, scene_hash: String) -> CriticalRow {
+        CriticalRow {
+            mu,
+            onset_rpm: self.onset_rpm,
+            bracket_rpm: self.bracket_rpm,
+            class_below: self.class_below,
+            class_above: self.class_above,
+            non_monotone: self.whirl_intervals_rpm.len() > 1,
+            whirl_intervals_rpm: self.whirl_intervals_rpm.clone(),
+            whirl_at_range_top: self.whirl_at_range_top,
+            drops: self.drops(),
+            failed_drops: self.failed_drops(),
+            converged: self.converged,
+            from_rpm: o.from_rpm,
+            to_rpm: o.to_rpm,
+            resolution_rpm: o.resolution_rpm,
+            tol_rpm: o.tol_rpm,
+            duration_s: o.duration_s,
+            scene_hash,
+            model_version: MODEL_VERSION,
+            note: self.note,
+            scan: self.scan,
+            bisections: self.bisections,
+            recheck: None,
         }
     }
-    None
 }
 
-/// Finds the lowest non-whirl-to-whirl transition of `classify_at` in `[from_rpm, to_rpm]`.
-///
-/// A coarse scan of `scan_points` uniform speeds (at least 2; evaluated in parallel and
-/// collected in speed order) picks the first pair of adjacent successful points with no
-/// whirl at the lower and whirl (backward or forward; the class is recorded) at the upper;
-/// bisection then narrows it until `hi - lo <= tol_rpm`. Known failed speeds are not run
-/// again; where a bisection drop fails, the search tries 3/8 and 5/8 of the bracket, and
-/// if those fail too it stops (`converged = false`, the bracket stays valid). Invalid ranges (see
-/// [`check_range`]) give no bracket and say so in the note; nothing is run.
-pub fn search<F: Fn(f64) -> Outcome + Sync>(
-    classify_at: F,
-    from_rpm: f64,
-    to_rpm: f64,
-    scan_points: usize,
+/// A transition between two neighbouring successful scan points, narrowed by bisection.
+#[derive(Debug, Clone, PartialEq)]
+struct Transition {
+    /// Lower and upper speed and their classes; exactly one side whirls.
+    lo: (f64, OrbitClass),
+    hi: (f64, OrbitClass),
+    probes: Vec<Probe>,
+    converged: bool,
+}
+
+impl Transition {
+    /// Whether this is a transition into whirl (no whirl below, whirl above).
+    fn is_into_whirl(&self) -> bool {
+        self.hi.1.is_whirl()
+    }
+    /// The speed on its whirl side.
+    fn whirl_side(&self) -> f64 {
+        if self.is_into_whirl() {
+            self.hi.0
+        } else {
+            self.lo.0
+        }
+    }
+}
+
+/// Narrows a transition between `lo` and `hi` (whirl on exactly one side) to `tol_rpm`,
+/// never re-running a speed in `failed` (a failed scan point is often exactly the midpoint).
+fn bisect<F: Fn(f64) -> Outcome>(
+    classify_at: &F,
+    lo: (f64, OrbitClass),
+    hi: (f64, OrbitClass),
     tol_rpm: f64,
-) -> CriticalResult {
-    let mut result = CriticalResult {
-        bracket: None,
-        class_lo: None,
-        class_hi: None,
-        converged: false,
-        drops_used: 0,
-        non_monotone: false,
-        scanned: Vec::new(),
-        bisected: Vec::new(),
-        failures: Vec::new(),
-        note: String::new(),
+    failed: &[f64],
+) -> Transition {
+    let mut t = Transition {
+        lo,
+        hi,
+        probes: Vec::new(),
+        converged: true,
     };
-    if let Err(e) = check_range(from_rpm, to_rpm, tol_rpm) {
-        result.note = format!("not searched: {e}");
-        return result;
-    }
-
-    // Coarse scan: parallel map, collected in speed order.
-    let speeds = scan_speeds(from_rpm, to_rpm, scan_points);
-    let outcomes: Vec<Outcome> = speeds.par_iter().map(|&s| classify_at(s)).collect();
-    result.drops_used += speeds.len();
-    for (&s, o) in speeds.iter().zip(outcomes) {
-        match o {
-            Outcome::Class(c) => result.scanned.push((s, c)),
-            Outcome::Failed(error) => result.failures.push(FailedDrop {
-                speed_rpm: s,
-                error,
-            }),
-        }
-    }
-
-    let mut notes: Vec<String> = Vec::new();
-    let scanned = result.scanned.clone();
-    match scanned.first() {
-        None => notes.push(format!(
-            "every drop failed ({} of {}): nothing decided",
-            result.failures.len(),
-            speeds.len()
-        )),
-        Some(&(s0, c0)) if c0.is_whirl() => {
-            let below = result.failures.iter().filter(|f| f.speed_rpm < s0).count();
-            if below == 0 {
-                notes.push(format!("already whirling at {} r/min", fmt_rpm(s0)));
-            } else {
-                notes.push(format!(
-                    "already whirling at {} r/min (lowest successful drop; {below} failed below)",
-                    fmt_rpm(s0)
-                ));
+    let lo_whirl = lo.1.is_whirl();
+    let mut steps = 0;
+    'bisect: while t.hi.0 - t.lo.0 > tol_rpm && steps < MAX_BISECTIONS {
+        steps += 1;
+        let mut next = None;
+        for frac in BISECTION_FRACTIONS {
+            let mid = t.lo.0 + frac * (t.hi.0 - t.lo.0);
+            if !(mid > t.lo.0 && mid < t.hi.0) {
+                break 'bisect; // float resolution reached
+            }
+            if failed.contains(&mid) || t.probes.iter().any(|p| p.speed_rpm == mid) {
+                continue;
+            }
+            let o = classify_at(mid);
+            t.probes.push(Probe::new(mid, &o));
+            if let Outcome::Class(c) = o {
+                next = Some((mid, c));
+                break;
             }
         }
-        Some(_) => {
-            let pair = scanned
-                .windows(2)
-                .find(|w| !w[0].1.is_whirl() && w[1].1.is_whirl());
-            match pair {
-                None => {
-                    let top = scanned.last().expect("not empty").0;
-                    notes.push(format!("no whirl up to {} r/min", fmt_rpm(top)));
-                }
-                Some(w) => {
-                    let (mut lo, mut c_lo) = w[0];
-                    let (mut hi, mut c_hi) = w[1];
-                    let mut converged = true;
-                    let mut steps = 0;
-                    'bisect: while hi - lo > tol_rpm && steps < MAX_BISECTIONS {
-                        steps += 1;
-                        // The midpoint, or beside it when a drop fails there (a failed scan
-                        // point is often exactly the midpoint of its neighbours).
-                        let mut next = None;
-                        for frac in BISECTION_FRACTIONS {
-                            let mid = lo + frac * (hi - lo);
-                            if !(mid > lo && mid < hi) {
-                                break 'bisect; // float resolution reached
-                            }
-                            if result.failures.iter().any(|f| f.speed_rpm == mid) {
-                                continue;
-                            }
-                            result.drops_used += 1;
-                            match classify_at(mid) {
-                                Outcome::Class(c) => {
-                                    next = Some((mid, c));
-                                    break;
-                                }
-                                Outcome::Failed(error) => result.failures.push(FailedDrop {
-                                    speed_rpm: mid,
-                                    error,
-                                }),
-                            }
-                        }
-                        let Some((mid, c)) = next else {
-                            notes.push(format!(
-                                "bisection stopped: drops failed inside [{}, {}] r/min",
-                                fmt_rpm(lo),
-                                fmt_rpm(hi)
-                            ));
-                            converged = false;
-                            break;
-                        };
-                        result.bisected.push((mid, c));
-                        if c.is_whirl() {
-                            (hi, c_hi) = (mid, c);
-                        } else {
-                            (lo, c_lo) = (mid, c);
-                        }
-                    }
-                    converged &= hi - lo <= tol_rpm;
-                    result.bracket = Some((lo, hi));
-                    result.class_lo = Some(c_lo);
-                    result.class_hi = Some(c_hi);
-                    result.converged = converged;
-                    notes.insert(
-                        0,
-                        format!(
-                            "{} at {} r/min, {} at {} r/min",
-                            c_lo.name(),
-                            fmt_rpm(lo),
-                            c_hi.name(),
-                            fmt_rpm(hi)
-                        ),
-                    );
-                    if c_lo == OrbitClass::Unresolved {
-                        notes.push("the lower side is unresolved, not a decided orbit".into());
-                    }
-                }
-            }
+        let Some((mid, c)) = next else {
+            t.converged = false;
+            break;
+        };
+        if c.is_whirl() == lo_whirl {
+            t.lo = (mid, c);
+        } else {
+            t.hi = (mid, c);
         }
     }
-
-    let mut all = result.scanned.clone();
-    all.extend_from_slice(&result.bisected);
-    if let Some((w, n)) = find_non_monotone(&all) {
-        result.non_monotone = true;
-        notes.push(format!(
-            "non-monotone: whirl at {} r/min below no whirl at {} r/min",
-            fmt_rpm(w),
-            fmt_rpm(n)
-        ));
-    }
-    if !result.failures.is_empty() {
-        notes.push(format!(
-            "{} drop(s) failed, counted as neither class",
-            result.failures.len()
-        ));
-    }
-    result.note = notes.join("; ");
-    result
+    t.converged &= t.hi.0 - t.lo.0 <= tol_rpm;
+    t
 }
 
 /// A speed for notes: integers without decimals, others with one.
-fn fmt_rpm(s: f64) -> String {
+pub fn fmt_rpm(s: f64) -> String {
     if s.fract() == 0.0 {
         format!("{s:.0}")
     } else {
@@ -362,72 +485,264 @@ fn fmt_rpm(s: f64) -> String {
     }
 }
 
-/// Classifies one drop of `scene` at `speed_rpm`.
-pub fn drop_outcome(
-    scene: &Scene,
-    speed_rpm: f64,
-    opts: &DropOptions,
-    params: &ClassifyParams,
-) -> Outcome {
+/// The successful scan points and the transitions between neighbours (not yet bisected).
+fn transitions_of(scan: &[Probe]) -> Vec<((f64, OrbitClass), (f64, OrbitClass))> {
+    let ok: Vec<(f64, OrbitClass)> = scan
+        .iter()
+        .filter_map(|p| p.class.map(|c| (p.speed_rpm, c)))
+        .collect();
+    ok.windows(2)
+        .filter(|w| w[0].1.is_whirl() != w[1].1.is_whirl())
+        .map(|w| (w[0], w[1]))
+        .collect()
+}
+
+/// Assembles a result from a scan (in speed order) and its bisected transitions (in speed
+/// order).
+fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>) -> SearchResult {
+    let ok: Vec<(f64, OrbitClass)> = scan
+        .iter()
+        .filter_map(|p| p.class.map(|c| (p.speed_rpm, c)))
+        .collect();
+    // Transitions between neighbours alternate into and out of whirl, in speed order.
+    let mut intervals: Vec<[f64; 2]> = Vec::new();
+    let mut onset_transition: Option<&Transition> = None;
+    let mut start = ok.first().filter(|p| p.1.is_whirl()).map(|p| p.0);
+    for t in &transitions {
+        if t.is_into_whirl() {
+            if start.is_none() && intervals.is_empty() {
+                onset_transition = Some(t);
+            }
+            start = Some(t.whirl_side());
+        } else if let Some(s) = start.take() {
+            intervals.push([s, t.whirl_side()]);
+        }
+    }
+    let whirl_at_range_top = start.is_some();
+    if let Some(s) = start {
+        intervals.push([s, ok[ok.len() - 1].0]);
+    }
+
+    let mut notes: Vec<String> = Vec::new();
+    let failed = scan.iter().filter(|p| p.error.is_some()).count();
+    let (mut onset, mut bracket, mut below, mut above) = (None, None, None, None);
+    if ok.is_empty() {
+        notes.push(format!(
+            "every scan drop failed ({failed} of {}): nothing decided",
+            scan.len()
+        ));
+    } else if intervals.is_empty() {
+        notes.push(format!(
+            "no whirl from {} to {} r/min",
+            fmt_rpm(ok[0].0),
+            fmt_rpm(ok[ok.len() - 1].0)
+        ));
+    } else if let Some(t) = onset_transition {
+        onset = Some(t.hi.0);
+        bracket = Some([t.lo.0, t.hi.0]);
+        below = Some(t.lo.1);
+        above = Some(t.hi.1);
+        notes.push(format!(
+            "{} at {} r/min, {} at {} r/min",
+            t.lo.1.name(),
+            fmt_rpm(t.lo.0),
+            t.hi.1.name(),
+            fmt_rpm(t.hi.0)
+        ));
+        if t.lo.1 == OrbitClass::Unresolved {
+            notes.push("the lower side is unresolved (counted as no whirl)".into());
+        }
+    } else {
+        onset = Some(ok[0].0);
+        above = Some(ok[0].1);
+        notes.push(format!(
+            "whirl already at {} r/min, the lowest speed scanned: the onset is at or below it",
+            fmt_rpm(ok[0].0)
+        ));
+    }
+    if intervals.len() > 1 {
+        let list = intervals
+            .iter()
+            .map(|[a, b]| format!("{}-{}", fmt_rpm(*a), fmt_rpm(*b)))
+            .collect::<Vec<_>>()
+            .join(", ");
+        notes.push(format!(
+            "non-monotone: whirl in {} intervals ({list} r/min)",
+            intervals.len()
+        ));
+    }
+    if whirl_at_range_top {
+        notes.push(format!(
+            "whirl up to the range top ({} r/min)",
+            fmt_rpm(ok[ok.len() - 1].0)
+        ));
+    }
+    let unresolved = scan
+        .iter()
+        .chain(transitions.iter().flat_map(|t| &t.probes))
+        .filter(|p| p.class == Some(OrbitClass::Unresolved))
+        .count();
+    if unresolved > 0 {
+        notes.push(format!(
+            "{unresolved} unresolved drop(s) counted as no whirl"
+        ));
+    }
+    let bisection_failures = transitions
+        .iter()
+        .flat_map(|t| &t.probes)
+        .filter(|p| p.error.is_some())
+        .count();
+    if failed + bisection_failures > 0 {
+        notes.push(format!(
+            "{} drop(s) failed, counted as neither class",
+            failed + bisection_failures
+        ));
+    }
+    let converged = transitions.iter().all(|t| t.converged);
+    if !converged {
+        notes.push(format!(
+            "a bisection stopped short of {} r/min (drops failed inside its bracket)",
+            fmt_rpm(o.tol_rpm)
+        ));
+    }
+    SearchResult {
+        onset_rpm: onset,
+        bracket_rpm: bracket,
+        class_below: below,
+        class_above: above,
+        whirl_intervals_rpm: intervals,
+        whirl_at_range_top,
+        converged,
+        bisections: transitions.into_iter().flat_map(|t| t.probes).collect(),
+        scan,
+        note: notes.join("; "),
+    }
+}
+
+/// A transition waiting to be bisected: the coefficient's index, its two sides, and the scan
+/// speeds that failed (not to be run again).
+type Pending = (usize, (f64, OrbitClass), (f64, OrbitClass), Vec<f64>);
+
+/// Searches `n` friction coefficients at once: `classify_at(j, speed)` classifies a drop of
+/// coefficient `j`. All scans run as one parallel batch, then all bisections; the results
+/// are in the order of `j` and do not depend on the thread count. Invalid settings run
+/// nothing (validate first with [`CriticalOptions::validate`]).
+pub fn search_all<F: Fn(usize, f64) -> Outcome + Sync>(
+    classify_at: F,
+    n: usize,
+    o: &CriticalOptions,
+) -> Result<Vec<SearchResult>, InvalidParameter> {
+    o.validate()?;
+    let speeds = o.scan_speeds();
+    let jobs: Vec<(usize, f64)> = (0..n)
+        .flat_map(|j| speeds.iter().map(move |&s| (j, s)))
+        .collect();
+    let outcomes: Vec<Outcome> = jobs.par_iter().map(|&(j, s)| classify_at(j, s)).collect();
+    let scans: Vec<Vec<Probe>> = outcomes
+        .chunks(speeds.len())
+        .map(|c| {
+            speeds
+                .iter()
+                .zip(c)
+                .map(|(&s, o)| Probe::new(s, o))
+                .collect()
+        })
+        .collect();
+    // Every transition of every coefficient, bisected in parallel.
+    let pending: Vec<Pending> = scans
+        .iter()
+        .enumerate()
+        .flat_map(|(j, scan)| {
+            let failed: Vec<f64> = scan
+                .iter()
+                .filter(|p| p.error.is_some())
+                .map(|p| p.speed_rpm)
+                .collect();
+            transitions_of(scan)
+                .into_iter()
+                .map(move |(lo, hi)| (j, lo, hi, failed.clone()))
+        })
+        .collect();
+    let bisected: Vec<(usize, Transition)> = pending
+        .par_iter()
+        .map(|(j, lo, hi, failed)| {
+            let f = |s: f64| classify_at(*j, s);
+            (*j, bisect(&f, *lo, *hi, o.tol_rpm, failed))
+        })
+        .collect();
+    let mut per_mu: Vec<Vec<Transition>> = vec![Vec::new(); n];
+    for (j, t) in bisected {
+        per_mu[j].push(t);
+    }
+    Ok(scans
+        .into_iter()
+        .zip(per_mu)
+        .map(|(scan, ts)| assemble(o, scan, ts))
+        .collect())
+}
+
+/// [`search_all`] for one class predicate.
+pub fn search<F: Fn(f64) -> Outcome + Sync>(
+    classify_at: F,
+    o: &CriticalOptions,
+) -> Result<SearchResult, InvalidParameter> {
+    let mut v = search_all(|_, s| classify_at(s), 1, o)?;
+    Ok(v.remove(0))
+}
+
+/// Classifies one drop of `scene` at `speed_rpm`: its class, or its failure (a solver error,
+/// or a panic inside the solver, caught so one bad drop cannot take a search down).
+pub fn drop_outcome(scene: &Scene, speed_rpm: f64, opts: &DropOptions) -> Outcome {
     let mut s = scene.clone();
     s.speed_rpm = speed_rpm;
-    match simulate(&s, opts) {
-        Ok(r) => Outcome::Class(classify(&r.features, r.stop_reason, params)),
-        Err(e) => Outcome::Failed(format!("{}: {e}", e.kind())),
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| simulate(&s, opts))) {
+        Ok(Ok(r)) => Outcome::Class(r.verdict.class),
+        Ok(Err(e)) => Outcome::Failed(format!("{}: {e}", e.kind())),
+        Err(payload) => Outcome::Failed(format!(
+            "panic: {}",
+            payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_default()
+        )),
     }
 }
 
 /// The critical whirl speed of `base` for each friction coefficient in `mus` (set as
-/// `mu_dynamic`), searched over `[from, to]` r/min with [`DEFAULT_SCAN_POINTS`] scan points
-/// down to `tol` r/min, each drop simulated for `duration_s` and classified with
-/// `ClassifyParams::default()`. The mus run in parallel; results are in the order of `mus`
-/// and do not depend on the thread count.
-pub fn critical_speeds(
-    base: &Scene,
-    mus: &[f64],
-    from: f64,
-    to: f64,
-    tol: f64,
-    duration_s: f64,
-) -> Vec<(f64, CriticalResult)> {
-    critical_speeds_with(
-        base,
-        mus,
-        &CriticalOptions {
-            from_rpm: from,
-            to_rpm: to,
-            tol_rpm: tol,
-            scan_points: DEFAULT_SCAN_POINTS,
-            duration_s,
-            classify: ClassifyParams::default(),
-        },
-    )
-}
-
-/// [`critical_speeds`] with every setting explicit.
-pub fn critical_speeds_with(
+/// `mu_dynamic`), with the real model. Scans and bisections of all coefficients run in
+/// parallel; rows are in the order of `mus` and do not depend on the thread count.
+pub fn critical_rows(
     base: &Scene,
     mus: &[f64],
     o: &CriticalOptions,
-) -> Vec<(f64, CriticalResult)> {
+) -> Result<Vec<CriticalRow>, InvalidParameter> {
+    check_mus(mus)?;
     let drop_opts = DropOptions {
         duration_s: o.duration_s,
         ..Default::default()
     };
-    mus.par_iter()
+    let scenes: Vec<Scene> = mus
+        .iter()
         .map(|&mu| {
-            let mut scene = base.clone();
-            scene.mu_dynamic = mu;
-            let r = search(
-                |s| drop_outcome(&scene, s, &drop_opts, &o.classify),
-                o.from_rpm,
-                o.to_rpm,
-                o.scan_points,
-                o.tol_rpm,
-            );
-            (mu, r)
+            let mut s = base.clone();
+            s.mu_dynamic = mu;
+            s
         })
-        .collect()
+        .collect();
+    for s in &scenes {
+        s.validate()?;
+    }
+    let results = search_all(
+        |j, speed| drop_outcome(&scenes[j], speed, &drop_opts),
+        scenes.len(),
+        o,
+    )?;
+    Ok(results
+        .into_iter()
+        .zip(mus.iter().zip(&scenes))
+        .map(|(r, (&mu, s))| r.into_row(mu, o, s.hash_hex()))
+        .collect())
 }
 
 #[cfg(test)]
@@ -435,6 +750,16 @@ mod tests {
     use super::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
     use OrbitClass::*;
+
+    fn opts(from: f64, to: f64) -> CriticalOptions {
+        CriticalOptions {
+            from_rpm: from,
+            to_rpm: to,
+            resolution_rpm: 250.0,
+            tol_rpm: 10.0,
+            duration_s: 1.0,
+        }
+    }
 
     fn step_at(threshold: f64) -> impl Fn(f64) -> Outcome + Sync {
         move |s| {
@@ -447,148 +772,185 @@ mod tests {
     }
 
     #[test]
+    fn the_scan_lies_on_multiples_of_the_resolution_plus_the_range_ends() {
+        let o = opts(1900.0, 3100.0);
+        assert_eq!(
+            o.scan_speeds(),
+            vec![1900.0, 2000.0, 2250.0, 2500.0, 2750.0, 3000.0, 3100.0]
+        );
+        assert_eq!(opts(2000.0, 3000.0).scan_speeds().len(), 5);
+    }
+
+    #[test]
     fn bisection_brackets_a_known_threshold_within_tolerance() {
         let calls = AtomicUsize::new(0);
         let f = |s: f64| {
             calls.fetch_add(1, Ordering::Relaxed);
             step_at(12345.6)(s)
         };
-        let r = search(f, 2000.0, 30000.0, 12, 50.0);
-        let (lo, hi) = r.bracket.expect("a bracket");
-        assert!(lo < 12345.6 && 12345.6 <= hi, "{lo} {hi}");
-        assert!(hi - lo <= 50.0);
-        assert!(r.converged);
-        assert_eq!(r.class_lo, Some(Pendulum));
-        assert_eq!(r.class_hi, Some(BackwardWhirl));
-        // Scan step 28000/11 = 2545.5 r/min; halving to <= 50 takes ceil(log2(50.9)) = 6.
-        assert_eq!(r.drops_used, 12 + 6);
-        assert_eq!(calls.load(Ordering::Relaxed), r.drops_used);
-        assert_eq!(r.bisected.len(), 6);
-        assert!(!r.non_monotone);
-        assert!(r.failures.is_empty());
-        assert_eq!(r.scanned.len(), 12);
-        assert_eq!(r.scanned[0].0, 2000.0);
-        assert_eq!(r.scanned[11].0, 30000.0);
-    }
-
-    #[test]
-    fn forward_whirl_counts_as_whirl_and_is_recorded() {
-        let f = |s: f64| Outcome::Class(if s >= 9000.0 { ForwardWhirl } else { Bouncing });
-        let r = search(f, 2000.0, 30000.0, 12, 100.0);
-        let (lo, hi) = r.bracket.unwrap();
-        assert!(lo < 9000.0 && 9000.0 <= hi && hi - lo <= 100.0);
-        assert_eq!(r.class_lo, Some(Bouncing));
-        assert_eq!(r.class_hi, Some(ForwardWhirl));
-    }
-
-    #[test]
-    fn non_monotone_boundary_is_flagged_and_the_lowest_transition_found() {
-        // Pendulum, a whirl pocket in [6000, 9000), a pendulum band, whirl from 20000.
-        let f = |s: f64| {
-            Outcome::Class(if (6000.0..9000.0).contains(&s) || s >= 20000.0 {
-                BackwardWhirl
-            } else {
-                Pendulum
-            })
-        };
-        let r = search(f, 2000.0, 30000.0, 12, 50.0);
-        let (lo, hi) = r.bracket.unwrap();
-        assert!(lo < 6000.0 && 6000.0 <= hi && hi - lo <= 50.0, "{lo} {hi}");
-        assert!(r.non_monotone);
-        assert!(r.note.contains("non-monotone"), "{}", r.note);
-    }
-
-    #[test]
-    fn no_transition_gives_no_bracket_and_says_why() {
-        let all_pendulum = |_s: f64| Outcome::Class(Pendulum);
-        let r = search(all_pendulum, 2000.0, 30000.0, 12, 50.0);
-        assert_eq!(r.bracket, None);
-        assert_eq!(r.class_lo, None);
-        assert_eq!(r.drops_used, 12);
-        assert_eq!(r.note, "no whirl up to 30000 r/min");
-        assert!(!r.non_monotone);
-
-        let all_whirl = |_s: f64| Outcome::Class(BackwardWhirl);
-        let r = search(all_whirl, 2000.0, 30000.0, 12, 50.0);
-        assert_eq!(r.bracket, None);
-        assert_eq!(r.drops_used, 12);
-        assert_eq!(r.note, "already whirling at 2000 r/min");
-
-        // Whirl at the bottom, pendulum above: still no number, but flagged.
-        let r = search(
-            |s: f64| Outcome::Class(if s < 5000.0 { BackwardWhirl } else { Pendulum }),
-            2000.0,
-            30000.0,
-            12,
-            50.0,
-        );
-        assert_eq!(r.bracket, None);
-        assert!(r.non_monotone);
+        let o = opts(2000.0, 30000.0);
+        let r = search(f, &o).unwrap();
+        let [lo, hi] = r.bracket_rpm.expect("a bracket");
         assert!(
-            r.note.starts_with("already whirling at 2000 r/min"),
-            "{}",
-            r.note
+            lo < 12345.6 && 12345.6 <= hi && hi - lo <= 10.0,
+            "{lo} {hi}"
+        );
+        assert_eq!(r.onset_rpm, Some(hi));
+        assert_eq!(
+            (r.class_below, r.class_above),
+            (Some(Pendulum), Some(BackwardWhirl))
+        );
+        // 113 lattice points; halving 250 to <= 10 takes 5 steps.
+        assert_eq!(r.scan.len(), 113);
+        assert_eq!(r.bisections.len(), 5);
+        assert_eq!(calls.load(Ordering::Relaxed), r.drops());
+        assert_eq!(r.whirl_intervals_rpm, vec![[hi, 30000.0]]);
+        assert!(r.whirl_at_range_top && r.converged);
+    }
+
+    #[test]
+    fn the_onset_does_not_depend_on_the_search_range() {
+        let f = step_at(4321.0);
+        let ranges = [
+            (2000.0, 30000.0),
+            (2000.0, 8000.0),
+            (3000.0, 5000.0),
+            (4100.0, 4400.0),
+        ];
+        let onsets: Vec<f64> = ranges
+            .iter()
+            .map(|&(a, b)| search(&f, &opts(a, b)).unwrap().onset_rpm.unwrap())
+            .collect();
+        // Ranges containing the lattice cell [4250, 4500] bisect it identically.
+        assert_eq!(onsets[0], onsets[1]);
+        assert_eq!(onsets[0], onsets[2]);
+        // A range end inside the cell changes the bisection, not the answer (within tol).
+        assert!((onsets[3] - onsets[0]).abs() <= 10.0, "{onsets:?}");
+        assert!(
+            onsets.iter().all(|&x| (4321.0..=4331.0).contains(&x)),
+            "{onsets:?}"
         );
     }
 
     #[test]
-    fn failed_drops_are_reported_and_count_as_neither_class() {
-        // Scan points: 2000, 4545.45, 7090.9, ...; the one at 7090.9 fails, just below the
-        // threshold. The transition is bracketed by its successful neighbours.
+    fn every_whirl_interval_is_found_and_non_monotone_means_more_than_one() {
+        // Whirl pocket [6000, 9000), a pendulum band, whirl from 20000 to 25000, then
+        // bouncing.
         let f = |s: f64| {
-            if (s - 7090.9).abs() < 1.0 {
+            Outcome::Class(
+                if (6000.0..9000.0).contains(&s) || (20000.0..25000.0).contains(&s) {
+                    BackwardWhirl
+                } else if s >= 25000.0 {
+                    Bouncing
+                } else {
+                    Pendulum
+                },
+            )
+        };
+        let r = search(f, &opts(2000.0, 30000.0)).unwrap();
+        assert_eq!(r.whirl_intervals_rpm.len(), 2);
+        let [[a, b], [c, d]] = [r.whirl_intervals_rpm[0], r.whirl_intervals_rpm[1]];
+        for (got, want) in [(a, 6000.0), (b, 9000.0), (c, 20000.0), (d, 25000.0)] {
+            assert!((got - want).abs() <= 10.0, "{got} vs {want}");
+        }
+        assert!(!r.whirl_at_range_top);
+        assert_eq!(r.onset_rpm, Some(a));
+        let row = r.into_row(0.3, &opts(2000.0, 30000.0), "x".into());
+        assert!(row.non_monotone);
+        assert!(row.note.contains("non-monotone"), "{}", row.note);
+    }
+
+    #[test]
+    fn a_single_interval_is_monotone_and_no_whirl_gives_no_onset() {
+        let r = search(step_at(5000.0), &opts(2000.0, 9000.0)).unwrap();
+        let row = r.into_row(0.4, &opts(2000.0, 9000.0), "x".into());
+        assert!(!row.non_monotone);
+        let r = search(|_| Outcome::Class(Pendulum), &opts(2000.0, 9000.0)).unwrap();
+        assert_eq!((r.onset_rpm, r.bracket_rpm), (None, None));
+        assert!(r.whirl_intervals_rpm.is_empty());
+        assert_eq!(r.note, "no whirl from 2000 to 9000 r/min");
+        assert!(r.bisections.is_empty());
+    }
+
+    #[test]
+    fn whirl_at_the_lowest_speed_gives_that_speed_without_a_bracket() {
+        let r = search(|_| Outcome::Class(BackwardWhirl), &opts(2000.0, 3000.0)).unwrap();
+        assert_eq!(r.onset_rpm, Some(2000.0));
+        assert_eq!(r.bracket_rpm, None);
+        assert!(r.note.contains("the onset is at or below it"), "{}", r.note);
+    }
+
+    #[test]
+    fn failed_drops_count_as_neither_class_and_are_not_run_again() {
+        // The lattice point 4500 fails, just above the threshold at 4400.
+        let f = |s: f64| {
+            if s == 4500.0 {
                 Outcome::Failed("step_size_underflow: test".into())
             } else {
-                step_at(8000.0)(s)
+                step_at(4400.0)(s)
             }
         };
-        let r = search(f, 2000.0, 30000.0, 12, 50.0);
-        assert_eq!(r.failures.len(), 1);
-        assert!((r.failures[0].speed_rpm - 7090.9).abs() < 1.0);
-        assert_eq!(r.scanned.len(), 11);
-        assert!(r.scanned.iter().all(|p| (p.0 - 7090.9).abs() > 1.0));
-        let (lo, hi) = r.bracket.unwrap();
-        assert!(lo < 8000.0 && 8000.0 <= hi && hi - lo <= 50.0);
+        let r = search(f, &opts(2000.0, 9000.0)).unwrap();
+        assert_eq!(r.failed_drops(), 1);
+        let [lo, hi] = r.bracket_rpm.unwrap();
+        assert!(lo < 4400.0 && 4400.0 <= hi && hi - lo <= 10.0);
+        assert!(r.bisections.iter().all(|p| p.speed_rpm != 4500.0));
         assert!(r.note.contains("1 drop(s) failed"), "{}", r.note);
-        assert!(!r.non_monotone);
-
-        // A failure in the bisection stops it with a valid but wide bracket.
-        let calls = AtomicUsize::new(0);
+        // Every drop failing decides nothing.
+        let r = search(|_| Outcome::Failed("x".into()), &opts(0.0, 500.0)).unwrap();
+        assert_eq!(r.onset_rpm, None);
+        assert!(r.note.contains("every scan drop failed"), "{}", r.note);
+        // Failures inside a bisection stop it with a valid, unconverged bracket.
         let g = |s: f64| {
-            if calls.fetch_add(1, Ordering::SeqCst) >= 12 {
+            if s.fract() != 0.0 || s % 250.0 != 0.0 {
                 Outcome::Failed("event_budget: test".into())
             } else {
-                step_at(8000.0)(s)
+                step_at(4400.0)(s)
             }
         };
-        let r = search(g, 2000.0, 30000.0, 12, 50.0);
-        let (lo, hi) = r.bracket.unwrap();
-        assert!(lo < 8000.0 && 8000.0 <= hi);
+        let r = search(g, &opts(2000.0, 9000.0)).unwrap();
         assert!(!r.converged);
-        assert_eq!(
-            r.drops_used,
-            12 + 3,
-            "midpoint and its two neighbours tried"
-        );
-        assert_eq!(r.failures.len(), 3);
-        assert!(r.note.contains("bisection stopped"), "{}", r.note);
-
-        // Every drop failed.
-        let r = search(|_| Outcome::Failed("x".into()), 0.0, 100.0, 3, 1.0);
-        assert_eq!(r.bracket, None);
-        assert_eq!(r.failures.len(), 3);
-        assert!(r.note.contains("every drop failed"), "{}", r.note);
+        assert_eq!(r.bracket_rpm, Some([4250.0, 4500.0]));
     }
 
     #[test]
-    fn invalid_ranges_run_nothing() {
-        let r = search(step_at(1.0), 5.0, 5.0, 12, 1.0);
-        assert_eq!((r.bracket, r.drops_used), (None, 0));
-        assert!(r.note.contains("to_rpm"), "{}", r.note);
-        assert_eq!(check_range(-1.0, 5.0, 1.0).unwrap_err().field, "from_rpm");
-        assert_eq!(check_range(0.0, 5.0, 0.0).unwrap_err().field, "tol_rpm");
+    fn invalid_settings_are_refused_by_name() {
+        let bad = |from, to, res, tol| check_range(from, to, res, tol).unwrap_err().field;
+        assert_eq!(bad(-1.0, 5.0, 1.0, 1.0), "from_rpm");
+        assert_eq!(bad(5.0, 5.0, 1.0, 1.0), "to_rpm");
+        assert_eq!(bad(0.0, 1e308, 250.0, 10.0), "to_rpm");
+        assert_eq!(bad(0.0, 5000.0, 0.0, 1.0), "resolution_rpm");
+        assert_eq!(bad(0.0, 1e6, 1.0, 1.0), "resolution_rpm");
+        assert_eq!(bad(0.0, 5000.0, 250.0, 1e-300), "tol_rpm");
+        assert_eq!(bad(0.0, 5000.0, 250.0, 300.0), "tol_rpm");
         assert_eq!(check_mus(&[]).unwrap_err().field, "mu");
         assert_eq!(check_mus(&[0.3, 2.5]).unwrap_err().field, "mu");
+        assert_eq!(check_mus(&[0.3, 0.3]).unwrap_err().field, "mu");
+        assert!(search(step_at(1.0), &opts(5.0, 5.0)).is_err());
+    }
+
+    #[test]
+    fn csv_rows_carry_the_scalar_fields() {
+        let r = search(step_at(5000.0), &opts(2000.0, 9000.0)).unwrap();
+        let row = r.into_row(0.4, &opts(2000.0, 9000.0), "abc".into());
+        let text = csv_text(std::slice::from_ref(&row));
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some(CSV_HEADER));
+        let line = lines.next().unwrap();
+        // Fields, with commas inside the quoted note kept in it.
+        let mut fields = vec![String::new()];
+        let mut quoted = false;
+        for ch in line.chars() {
+            match ch {
+                '"' => quoted = !quoted,
+                ',' if !quoted => fields.push(String::new()),
+                c => fields.last_mut().unwrap().push(c),
+            }
+        }
+        assert_eq!(fields.len(), CSV_HEADER.split(',').count(), "{line}");
+        assert_eq!(fields.last().unwrap(), &row.note);
+        assert!(line.starts_with("0.4,"), "{line}");
+        assert!(line.contains(",pendulum,backward_whirl,"), "{line}");
     }
 
     #[test]
@@ -599,26 +961,26 @@ mod tests {
                 .build()
                 .unwrap()
                 .install(|| {
-                    critical_speeds_with(
+                    critical_rows(
                         &Scene::paper(),
                         &[0.4, 0.3],
                         &CriticalOptions {
-                            from_rpm: 2000.0,
-                            to_rpm: 8000.0,
-                            tol_rpm: 1000.0,
-                            scan_points: 4,
+                            from_rpm: 4000.0,
+                            to_rpm: 5000.0,
+                            resolution_rpm: 500.0,
+                            tol_rpm: 250.0,
                             duration_s: 0.2,
-                            ..Default::default()
                         },
                     )
+                    .unwrap()
                 })
         };
         let one = run(1);
         let three = run(3);
         assert_eq!(one, three);
-        assert_eq!(one[0].0, 0.4);
-        assert_eq!(one[1].0, 0.3);
+        assert_eq!((one[0].mu, one[1].mu), (0.4, 0.3));
         let json = serde_json::to_string(&one).unwrap();
-        assert!(json.contains("\"bracket\""), "{json}");
+        let back: Vec<CriticalRow> = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, one);
     }
 }

@@ -434,6 +434,7 @@ impl EnsembleSpec {
             charts: Vec::new(),
             orbits: None,
             fidelity: self.fidelity,
+            probability: None,
         }
     }
 

@@ -1,8 +1,7 @@
 //! What a sweep spec asks for beside its grid: the critical-speed search (`critical.json`)
 //! and the orbits of the Fig. 3 chart (`orbits/*.json`), in the forms [`crate::charts`] reads.
 
-use crate::classify::{classify, ClassifyParams};
-use crate::critical::critical_speeds;
+use crate::critical::{critical_rows, csv_text, CriticalRow};
 use crate::spec::SweepSpec;
 use rayon::prelude::*;
 use serde_json::json;
@@ -36,31 +35,49 @@ fn write(path: &Path, text: &str) -> Result<(), ExtrasError> {
     })
 }
 
-/// Runs both extras on `threads` worker threads (rayon's default when `None`), as the grid
-/// did: the critical search, then the orbits. Returns the files written.
-#[allow(clippy::type_complexity)]
+/// The files the extras wrote.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ExtrasWritten {
+    /// `critical.json`, when the spec has a critical section.
+    pub critical: Option<PathBuf>,
+    /// The orbit files.
+    pub orbits: Vec<PathBuf>,
+    /// The probability ensemble's folder, when the spec has a probability section.
+    pub probability: Option<PathBuf>,
+}
+
+/// Runs every extra on `threads` worker threads (rayon's default when `None`), as the grid
+/// did: the critical search, the orbits, then the probability ensemble (with progress lines
+/// when `progress`).
 pub fn run_all(
     spec: &SweepSpec,
     out_dir: &Path,
     threads: Option<usize>,
-) -> Result<(Option<PathBuf>, Vec<PathBuf>), ExtrasError> {
-    run_all_owned(spec, out_dir, threads, |_| true)
+    progress: bool,
+) -> Result<ExtrasWritten, ExtrasError> {
+    run_all_owned(spec, out_dir, threads, progress, |_| true)
 }
 
 /// [`run_all`] for a shard's part: the critical searches at positions `j` of `critical.mu`
-/// and the orbit panels at positions `i` for which `owns` is true.
-#[allow(clippy::type_complexity)]
+/// and the orbit panels at positions `i` for which `owns` is true, and the probability
+/// ensemble when `owns(0)` (it is one job).
 pub fn run_all_owned(
     spec: &SweepSpec,
     out_dir: &Path,
     threads: Option<usize>,
+    progress: bool,
     owns: impl Fn(usize) -> bool + Sync,
-) -> Result<(Option<PathBuf>, Vec<PathBuf>), ExtrasError> {
+) -> Result<ExtrasWritten, ExtrasError> {
     let work = || -> Result<_, ExtrasError> {
-        Ok((
-            run_critical_owned(spec, out_dir, &owns)?,
-            record_orbits_owned(spec, out_dir, &owns)?,
-        ))
+        Ok(ExtrasWritten {
+            critical: run_critical_owned(spec, out_dir, &owns)?,
+            orbits: record_orbits_owned(spec, out_dir, &owns)?,
+            probability: if owns(0) {
+                run_probability(spec, out_dir, threads, progress)?
+            } else {
+                None
+            },
+        })
     };
     match threads {
         Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
@@ -71,8 +88,37 @@ pub fn run_all_owned(
     }
 }
 
-/// Runs the spec's `critical` section, if any, and writes `critical.json`: an array of
-/// `{"mu", "result"}` in the order of `critical.mu`. Returns the file written.
+/// Runs the spec's probability ensemble, if any, into `out_dir/probability/`.
+pub fn run_probability(
+    spec: &SweepSpec,
+    out_dir: &Path,
+    threads: Option<usize>,
+    progress: bool,
+) -> Result<Option<PathBuf>, ExtrasError> {
+    let Some(e) = spec.probability_spec() else {
+        return Ok(None);
+    };
+    let dir = out_dir.join(PROBABILITY_DIR);
+    crate::ensemble::run_ensemble(&e, &dir, threads, progress).map_err(|err| match err {
+        crate::sweep::SweepError::Io { path, source } => ExtrasError::Io { path, source },
+        other => ExtrasError::Io {
+            path: dir.clone(),
+            source: std::io::Error::other(other.to_string()),
+        },
+    })?;
+    Ok(Some(dir))
+}
+
+/// Folder of the sweep's probability ensemble (its `contours.json` feeds Fig. 4's band).
+pub const PROBABILITY_DIR: &str = "probability";
+
+/// Critical-speed results file (a JSON list of [`CriticalRow`]).
+pub const CRITICAL_FILE: &str = "critical.json";
+/// The same rows as a table (one line per friction coefficient).
+pub const CRITICAL_CSV_FILE: &str = "critical.csv";
+
+/// Runs the spec's `critical` section, if any, and writes `critical.json` (a list of
+/// [`CriticalRow`] in the order of `critical.mu`) and `critical.csv`. Returns the JSON file.
 pub fn run_critical(spec: &SweepSpec, out_dir: &Path) -> Result<Option<PathBuf>, ExtrasError> {
     run_critical_owned(spec, out_dir, |_| true)
 }
@@ -87,27 +133,31 @@ pub fn run_critical_owned(
     let Some(c) = &spec.critical else {
         return Ok(None);
     };
-    let mus: Vec<f64> = (c.mu.iter().enumerate())
+    let mus: Vec<f64> = (c.mus().into_iter().enumerate())
         .filter(|(j, _)| owns(*j))
-        .map(|(_, mu)| *mu)
+        .map(|(_, mu)| mu)
         .collect();
-    let results = critical_speeds(
-        &spec.base_scene(),
-        &mus,
-        c.speed_rpm.from,
-        c.speed_rpm.to,
-        c.tol_rpm,
-        spec.duration_s,
-    );
-    let rows: Vec<_> = results
-        .iter()
-        .map(|(mu, r)| json!({"mu": mu, "result": r}))
-        .collect();
-    let path = out_dir.join("critical.json");
+    let rows = if mus.is_empty() {
+        Vec::new()
+    } else {
+        // The spec was validated before anything ran, so this cannot fail.
+        critical_rows(&spec.base_scene(), &mus, &c.options(spec.duration_s))
+            .expect("the spec's critical section was validated")
+    };
+    write_critical(out_dir, &rows)
+}
+
+/// Writes `rows` as `critical.json` and `critical.csv` in `out_dir`; returns the JSON file.
+pub fn write_critical(
+    out_dir: &Path,
+    rows: &[CriticalRow],
+) -> Result<Option<PathBuf>, ExtrasError> {
+    let path = out_dir.join(CRITICAL_FILE);
     write(
         &path,
-        &serde_json::to_string_pretty(&rows).expect("results serialise"),
+        &serde_json::to_string_pretty(rows).expect("results serialise"),
     )?;
+    write(&out_dir.join(CRITICAL_CSV_FILE), &csv_text(rows))?;
     Ok(Some(path))
 }
 
@@ -175,7 +225,7 @@ pub fn record_orbits_owned(
         let stem = format!("{i:02}_{speed:.0}rpm_mu{mu:.3}");
         match run {
             Ok(r) => {
-                let class = classify(&r.features, r.stop_reason, &ClassifyParams::default());
+                let class = r.verdict.class;
                 let doc = json!({"speed_rpm": speed, "mu": mu, "class": class, "orbit": r.orbit});
                 let path = out_dir.join("orbits").join(format!("{stem}.json"));
                 write(

@@ -217,7 +217,7 @@ pub fn run_point(p: &ExtremePoint) -> ExtremeOutcome {
         ("contact_time_s", f.contact_time_s),
         ("net_whirl_turns", f.net_whirl_turns),
         ("whirl_frequency_hz", f.whirl_frequency_hz),
-        ("window.contact_duty", f.window.contact_duty),
+        ("window.contact_duty", f.window.stats.contact_duty),
         ("final_rotor_speed_rpm", f.final_rotor_speed_rpm),
         ("final_race_speed_rpm", f.final_race_speed_rpm),
         ("initial_j", e.initial_j),

@@ -28,6 +28,7 @@ pub mod critical;
 pub mod ensemble;
 pub mod extras;
 pub mod extremes;
+pub mod fig4;
 pub mod fonts;
 pub mod merge;
 pub mod overrides;

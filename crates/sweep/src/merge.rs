@@ -16,7 +16,8 @@
 //! shards' wall times in grid order), and the charts.
 
 use crate::charts::{render_all, ChartError};
-use crate::extras::orbit_panels;
+use crate::critical::CriticalRow;
+use crate::extras::{orbit_panels, write_critical, CRITICAL_FILE, PROBABILITY_DIR};
 use crate::shard::{read_shard_manifest, spec_hash, Shard, ShardManifest};
 use crate::spec::{check_output_dir, Point, SpecError};
 use crate::sweep::{
@@ -311,12 +312,13 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
     }
 
     // Critical searches: row `k` of a shard's critical.json is its k-th owned position.
-    let mut critical_rows: Vec<Option<Value>> = Vec::new();
+    let mut critical_rows: Vec<Option<CriticalRow>> = Vec::new();
     if let Some(c) = &spec.critical {
-        critical_rows = vec![None; c.mu.len()];
+        let c_mu = c.mus();
+        critical_rows = vec![None; c_mu.len()];
         for s in &shards {
-            let path = s.dir.join("critical.json");
-            let rows: Option<Vec<Value>> = std::fs::read_to_string(&path)
+            let path = s.dir.join(CRITICAL_FILE);
+            let rows: Option<Vec<CriticalRow>> = std::fs::read_to_string(&path)
                 .ok()
                 .and_then(|t| serde_json::from_str(&t).ok());
             let Some(rows) = rows.filter(|r| r.len() == s.m.critical_mu.len()) else {
@@ -324,7 +326,7 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
                     let mus: Vec<String> =
                         s.m.critical_mu
                             .iter()
-                            .map(|j| c.mu[*j].to_string())
+                            .map(|j| c_mu[*j].to_string())
                             .collect();
                     problems.push(format!(
                         "{} lacks its critical-speed searches (mu = {}): {} is missing or \
@@ -337,12 +339,12 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
                 continue;
             };
             for (j, row) in s.m.critical_mu.iter().zip(rows) {
-                if row.get("mu").and_then(Value::as_f64) != c.mu.get(*j).copied() {
+                if Some(row.mu) != c_mu.get(*j).copied() {
                     problems.push(format!(
                         "{}: row for mu = {} expected, found {}",
                         path.display(),
-                        c.mu[*j],
-                        row.get("mu").unwrap_or(&Value::Null)
+                        c_mu[*j],
+                        row.mu
                     ));
                 }
                 critical_rows[*j] = Some(row);
@@ -357,9 +359,10 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
     for owner in (0..count).filter(|o| !claims.contains_key(o)) {
         let who = format!("shard {owner}/{count} (no folder given)");
         if let Some(c) = &spec.critical {
-            let mus: Vec<String> = (0..c.mu.len())
+            let c_mu = c.mus();
+            let mus: Vec<String> = (0..c_mu.len())
                 .filter(|j| Shard::owner_of(*j, count) == owner)
-                .map(|j| c.mu[j].to_string())
+                .map(|j| c_mu[j].to_string())
                 .collect();
             if !mus.is_empty() {
                 problems.push(format!(
@@ -398,6 +401,37 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
         }
     }
 
+    // The probability ensemble: one job, run by shard 0 into its `probability/`.
+    let mut probability_files: Vec<PathBuf> = Vec::new();
+    if spec.probability.is_some() {
+        match shards.iter().find(|s| s.m.shard == 0) {
+            Some(s) => {
+                let dir = s.dir.join(PROBABILITY_DIR);
+                let contours = dir.join(crate::ensemble::CONTOURS_FILE);
+                if contours.is_file() {
+                    if let Ok(entries) = std::fs::read_dir(&dir) {
+                        let mut files: Vec<PathBuf> = entries
+                            .flatten()
+                            .map(|e| e.path())
+                            .filter(|p| p.is_file())
+                            .collect();
+                        files.sort();
+                        probability_files = files;
+                    }
+                } else {
+                    problems.push(format!(
+                        "{} lacks the probability ensemble: no {}",
+                        s.name(),
+                        contours.display()
+                    ));
+                }
+            }
+            None => problems.push(format!(
+                "shard 0/{count} (no folder given) lacks the probability ensemble"
+            )),
+        }
+    }
+
     // The output folder must not be an input.
     let out_canon = std::fs::canonicalize(out_dir).ok();
     for s in &shards {
@@ -423,16 +457,24 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
     write_atomic(&out_dir.join(POINTS_FILE), text.as_bytes())?;
     write_timings(&shards, &out_dir.join(TIMINGS_FILE))?;
     if spec.critical.is_some() {
-        let rows: Vec<Value> = critical_rows.into_iter().flatten().collect();
-        let path = out_dir.join("critical.json");
-        let text = serde_json::to_string_pretty(&rows).expect("rows serialise");
-        std::fs::write(&path, text).map_err(io_err(&path))?;
+        let rows: Vec<CriticalRow> = critical_rows.into_iter().flatten().collect();
+        write_critical(out_dir, &rows).map_err(|e| match e {
+            crate::extras::ExtrasError::Io { path, source } => SweepError::Io { path, source },
+        })?;
     }
     if !orbit_files.is_empty() {
         let dir = out_dir.join("orbits");
         std::fs::create_dir_all(&dir).map_err(io_err(&dir))?;
         for src in &orbit_files {
             let dst = dir.join(src.file_name().expect("orbit files have names"));
+            std::fs::copy(src, &dst).map_err(io_err(&dst))?;
+        }
+    }
+    if !probability_files.is_empty() {
+        let dir = out_dir.join(PROBABILITY_DIR);
+        std::fs::create_dir_all(&dir).map_err(io_err(&dir))?;
+        for src in &probability_files {
+            let dst = dir.join(src.file_name().expect("probability files have names"));
             std::fs::copy(src, &dst).map_err(io_err(&dst))?;
         }
     }

@@ -117,7 +117,7 @@ mod tests {
         assert_eq!(s.thermal.as_ref().unwrap().macro_step_s, 0.002);
         // Every listed field, nested ones too, is settable from a scene that omits it.
         for (key, value) in [
-            ("support_damping_isotropic", "true"),
+            ("support_damper", "\"radial_only\""),
             ("release_velocity_m_s", "[0, -1e-3]"),
             ("solver.free_flight_gap_bound", "true"),
             ("solver.race_atol_scale", "100"),

@@ -5,8 +5,7 @@
 //! result says whether the tighter model agrees (non-whirl below, whirl above) and is
 //! recorded next to the bracket.
 
-use crate::classify::ClassifyParams;
-use crate::critical::{drop_outcome, CriticalResult, Outcome};
+use crate::critical::{drop_outcome, CriticalRow, Outcome};
 use serde::{Deserialize, Serialize};
 use whirlmap_core::{DropOptions, Fidelity, Scene};
 
@@ -23,24 +22,19 @@ pub struct Recheck {
     pub confirmed: bool,
 }
 
-/// Re-runs the bracket of `result` (searched on `scene`, whose `mu_dynamic` is set) at
+/// Re-runs the onset bracket of `row` (searched on `scene`, whose `mu_dynamic` is set) at
 /// `tighter`; `None` without a bracket.
 pub fn recheck_bracket(
     scene: &Scene,
-    result: &CriticalResult,
+    row: &CriticalRow,
     tighter: Fidelity,
     opts: &DropOptions,
-    params: &ClassifyParams,
 ) -> Option<Recheck> {
-    let (lo, hi) = result.bracket?;
+    let [lo, hi] = row.bracket_rpm?;
     let s = tighter.applied(scene);
-    let out_lo = drop_outcome(&s, lo, opts, params);
-    let out_hi = drop_outcome(&s, hi, opts, params);
-    let whirl = |o: &Outcome| match o {
-        Outcome::Class(c) => Some(c.is_whirl()),
-        Outcome::Failed(_) => None,
-    };
-    let confirmed = whirl(&out_lo) == Some(false) && whirl(&out_hi) == Some(true);
+    let out_lo = drop_outcome(&s, lo, opts);
+    let out_hi = drop_outcome(&s, hi, opts);
+    let confirmed = out_lo.whirl() == Some(false) && out_hi.whirl() == Some(true);
     Some(Recheck {
         fidelity: tighter,
         lo: (lo, out_lo),

@@ -1,7 +1,7 @@
 //! The JSON record of one drop. Field names are a contract that later work and users rely on
 //! (see the README's "JSON contract").
 
-use crate::classify::{classify, ClassifyParams, OrbitClass};
+use crate::classify::{OrbitClass, Reason};
 use serde::{Deserialize, Serialize};
 use whirlmap_core::ode::Stats;
 use whirlmap_core::thermal::{HeatEnergies, NodeTemperatures};
@@ -10,8 +10,13 @@ use whirlmap_core::{DropReport, EnergyAudit, Features, StopReason, MODEL_VERSION
 /// One drop's outputs, as written by `whirlmap drop --json` and, per point, by sweeps.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DropRecord {
-    /// Orbit class.
+    /// Orbit class: the motion the rotor settled into ([`crate::classify`]).
     pub class: OrbitClass,
+    /// Why it got that class; for `unresolved`, why it had not settled at the cap.
+    pub class_reason: Reason,
+    /// Net turns of the contact point before the motion that decided the class (signed
+    /// relative to the spin): a transient whirl that died out shows here.
+    pub transient_whirl_turns: f64,
     /// Peak force of the first impact after free fall (N).
     pub first_contact_force_n: f64,
     /// Maximum rotor-race contact force over the run (N).
@@ -26,8 +31,10 @@ pub struct DropRecord {
     pub contact_duty: f64,
     /// Impacts (contact episodes, merged within 0.5 ms).
     pub impacts: u64,
-    /// Simulated time reached (s).
+    /// Simulated time reached (s): when the class was decided, or the extension cap.
     pub end_time_s: f64,
+    /// How far the run was extended past its duration to let the class settle (s).
+    pub extension_s: f64,
     /// Why the run ended.
     pub stop_reason: StopReason,
     /// The energy audit.
@@ -53,19 +60,22 @@ pub struct DropRecord {
 }
 
 impl DropRecord {
-    /// Builds the record of a finished drop, classifying it with `params`.
-    pub fn from_report(r: &DropReport, params: &ClassifyParams) -> Self {
+    /// Builds the record of a finished drop.
+    pub fn from_report(r: &DropReport) -> Self {
         let f = &r.features;
         Self {
-            class: classify(f, r.stop_reason, params),
+            class: r.verdict.class,
+            class_reason: r.verdict.reason,
+            transient_whirl_turns: f.transient_whirl_turns,
             first_contact_force_n: f.first_contact_force_n,
             max_contact_force_n: f.max_contact_force_n,
             peak_friction_power_w: f.peak_friction_power_w,
             peak_heat_power_w: f.peak_heat_power_w,
             whirl_frequency_hz: f.whirl_frequency_hz,
-            contact_duty: f.window.contact_duty,
+            contact_duty: f.window.stats.contact_duty,
             impacts: f.impacts,
             end_time_s: r.end_time_s,
+            extension_s: r.extension_s,
             stop_reason: r.stop_reason,
             energy: r.energy,
             stats: r.stats,

@@ -147,7 +147,7 @@ pub fn shard_manifest(spec: &SweepSpec, shard: Shard) -> Result<ShardManifest, S
         model_version: MODEL_VERSION,
         whirlmap_version: env!("CARGO_PKG_VERSION").to_string(),
         points,
-        critical_mu: owned(spec.critical.as_ref().map_or(0, |c| c.mu.len())),
+        critical_mu: owned(spec.critical.as_ref().map_or(0, |c| c.mus().len())),
         orbit_panels: owned(n_orbits),
         complete: false,
         spec: spec.clone(),
@@ -201,7 +201,11 @@ pub fn run_shard(
     };
     write(&manifest)?;
     let outcome = run_sweep_part(spec, opts, Some(&shard))?;
-    let (critical, _orbits) = run_all_owned(spec, &opts.out_dir, opts.threads, |k| shard.owns(k))?;
+    let progress = opts.progress != crate::sweep::ProgressMode::Off;
+    let critical = run_all_owned(spec, &opts.out_dir, opts.threads, progress, |k| {
+        shard.owns(k)
+    })?
+    .critical;
     write(&ShardManifest {
         complete: true,
         ..manifest

@@ -159,21 +159,48 @@ pub struct RangeSpec {
 }
 
 fn default_tol_rpm() -> f64 {
-    50.0
+    crate::critical::DEFAULT_TOL_RPM
 }
 
-/// The critical-speed search: for each `mu`, the speed in `speed_rpm` where the orbit
-/// turns into whirl, located to within `tol_rpm`.
+fn default_resolution_rpm() -> f64 {
+    crate::critical::DEFAULT_RESOLUTION_RPM
+}
+
+/// The critical-speed search ([`crate::critical`]): for each `mu`, the onset of sustained
+/// whirl and every whirl interval in `speed_rpm`, scanned on a lattice of `resolution_rpm`
+/// and bisected to `tol_rpm`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CriticalSpec {
-    /// Friction coefficients (each in [0, 2], at least one).
-    pub mu: Vec<f64>,
-    /// Speed bracket (r/min).
+    /// Friction coefficients: a list or `{"from", "to", "steps"}` (each in [0, 2], at least
+    /// one, none twice).
+    pub mu: AxisValues,
+    /// Speed range searched (r/min): `from` in [0, 1e6), `to` in (`from`, 1e6].
     pub speed_rpm: RangeSpec,
-    /// Tolerance on the critical speed (r/min), > 0. Default 50.
+    /// Lattice step of the scan (r/min), [1, 1e5]. Default 250.
+    #[serde(default = "default_resolution_rpm")]
+    pub resolution_rpm: f64,
+    /// Bisection tolerance (r/min), [0.01, `resolution_rpm`]. Default 25.
     #[serde(default = "default_tol_rpm")]
     pub tol_rpm: f64,
+}
+
+impl CriticalSpec {
+    /// The friction coefficients, in order.
+    pub fn mus(&self) -> Vec<f64> {
+        self.mu.values()
+    }
+
+    /// The search settings for drops of `duration_s`.
+    pub fn options(&self, duration_s: f64) -> crate::critical::CriticalOptions {
+        crate::critical::CriticalOptions {
+            from_rpm: self.speed_rpm.from,
+            to_rpm: self.speed_rpm.to,
+            resolution_rpm: self.resolution_rpm,
+            tol_rpm: self.tol_rpm,
+            duration_s,
+        }
+    }
 }
 
 /// The values of one axis: a list, or `steps` evenly spaced points from `from` to `to`.
@@ -348,9 +375,41 @@ pub struct SweepSpec {
     /// as every earlier sweep ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fidelity: Option<Fidelity>,
+    /// A whirl-probability ensemble over uncontrolled release conditions on its own
+    /// (usually coarser) grid, run into `probability/`; Fig. 4 draws its P(whirl) band.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probability: Option<ProbabilitySpec>,
+}
+
+/// A sweep's probability ensemble ([`crate::ensemble`]): its grid and what each member draws.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbabilitySpec {
+    /// The ensemble's grid (`speed_rpm` and `mu`, as sweep axes).
+    pub axes: Axes,
+    /// Simulated time of each member (s); default the sweep's `duration_s`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duration_s: Option<f64>,
+    /// Members per cell, seed, the drawn release conditions and the contour levels.
+    pub ensemble: crate::ensemble::EnsembleParams,
 }
 
 impl SweepSpec {
+    /// The probability section as an ensemble spec (its base scene and fidelity are the
+    /// sweep's), named `<name>-probability`.
+    pub fn probability_spec(&self) -> Option<crate::ensemble::EnsembleSpec> {
+        let p = self.probability.as_ref()?;
+        Some(crate::ensemble::EnsembleSpec {
+            name: format!("{}-probability", self.name),
+            scene: self.scene.clone(),
+            duration_s: p.duration_s.unwrap_or(self.duration_s),
+            axes: p.axes.clone(),
+            ensemble: Some(p.ensemble.clone()),
+            adaptive: None,
+            fidelity: self.fidelity,
+        })
+    }
+
     /// The base scene with the fidelity preset, if any, applied: what every drop of the
     /// sweep, its critical search and its orbits start from.
     pub fn base_scene(&self) -> Scene {
@@ -525,24 +584,39 @@ impl SweepSpec {
             });
         }
         if let Some(c) = &self.critical {
-            if c.mu.is_empty() {
-                return Err(SpecError::Invalid {
-                    field: "critical.mu".into(),
-                    value: "[]".into(),
-                    allowed: "at least one value".into(),
+            if let AxisValues::Range { steps: 0, .. } = c.mu {
+                return Err(SpecError::ZeroSteps {
+                    axis: "critical.mu".into(),
                 });
             }
-            for v in &c.mu {
+            if let AxisValues::Range { from, to, .. } = c.mu {
+                check_range("critical.mu", from, to)?;
+            }
+            let mus = c.mus();
+            for v in &mus {
                 check_mu("critical.mu", *v)?;
             }
-            check_range("critical.speed_rpm", c.speed_rpm.from, c.speed_rpm.to)?;
-            if !(c.tol_rpm > 0.0 && c.tol_rpm.is_finite()) {
-                return Err(SpecError::Invalid {
-                    field: "critical.tol_rpm".into(),
-                    value: c.tol_rpm.to_string(),
-                    allowed: "> 0 r/min".into(),
-                });
-            }
+            let invalid = |e: InvalidParameter, field: &str| SpecError::Invalid {
+                field: format!("critical.{field}"),
+                value: e.value,
+                allowed: e.allowed,
+            };
+            crate::critical::check_mus(&mus).map_err(|e| invalid(e, "mu"))?;
+            crate::critical::check_range(
+                c.speed_rpm.from,
+                c.speed_rpm.to,
+                c.resolution_rpm,
+                c.tol_rpm,
+            )
+            .map_err(|e| {
+                let field = match e.field.as_str() {
+                    "from_rpm" => "speed_rpm.from",
+                    "to_rpm" => "speed_rpm.to",
+                    other => other,
+                }
+                .to_string();
+                invalid(e, &field)
+            })?;
         }
         if let Some(o) = &self.orbits {
             if o.mu.is_empty() {
@@ -562,6 +636,21 @@ impl SweepSpec {
                     allowed: "[-1e6, 1e6] r/min".into(),
                 });
             }
+        }
+        if let Some(e) = self.probability_spec() {
+            // Grid, draws and every cell with the widest draws.
+            e.cells().map_err(|err| match err {
+                SpecError::Invalid {
+                    field,
+                    value,
+                    allowed,
+                } => SpecError::Invalid {
+                    field: format!("probability.{field}"),
+                    value,
+                    allowed,
+                },
+                other => other,
+            })?;
         }
         for c in &self.charts {
             if !CHART_NAMES.contains(&c.as_str()) {
@@ -692,7 +781,8 @@ mod tests {
         assert_eq!(spec.scene.solver.rtol, 1e-6);
         assert_eq!(spec.scene.mu_dynamic, 0.1, "unset fields keep the default");
         let c = spec.critical.as_ref().unwrap();
-        assert_eq!(c.tol_rpm, 50.0);
+        assert_eq!(c.tol_rpm, 25.0, "the default");
+        assert_eq!(c.resolution_rpm, 250.0, "the default");
         assert_eq!(
             c.speed_rpm,
             RangeSpec {

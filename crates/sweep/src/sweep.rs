@@ -14,7 +14,6 @@
 //! points recorded `ok`, re-runs failed ones, and at the end rewrites the file in grid order
 //! with one line per point, so it is byte-identical to an uninterrupted run.
 
-use crate::classify::ClassifyParams;
 use crate::record::DropRecord;
 use crate::spec::{check_output_dir, Point, SpecError, SweepSpec};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -154,8 +153,7 @@ pub fn run_case(point: &Point, duration_s: f64) -> PointRecord {
         ..Default::default()
     };
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        simulate(&point.scene, &opts)
-            .map(|r| DropRecord::from_report(&r, &ClassifyParams::default()))
+        simulate(&point.scene, &opts).map(|r| DropRecord::from_report(&r))
     }));
     let (status, record, error) = match result {
         Ok(Ok(rec)) => (Status::Ok, Some(rec), None),

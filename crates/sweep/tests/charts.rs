@@ -4,6 +4,8 @@ use std::path::{Path, PathBuf};
 
 use serde_json::json;
 use whirlmap_sweep::charts::{load_points, render_all, ChartError, PointStatus};
+use whirlmap_sweep::classify::OrbitClass;
+use whirlmap_sweep::critical::{CriticalOptions, CriticalRow, Probe, SearchResult};
 
 const SPEEDS: [f64; 6] = [2000.0, 4000.0, 6000.0, 8000.0, 10000.0, 12000.0];
 const MUS: [f64; 5] = [0.05, 0.1, 0.15, 0.2, 0.3];
@@ -66,21 +68,7 @@ pub fn write_synthetic(dir: &Path, orbits: usize) {
     text.push_str("\n{\"key\": \"p99\", \"index\": 99, \"inputs\": {\"speed_r");
     std::fs::write(dir.join("points.jsonl"), text).unwrap();
 
-    let mut critical = Vec::new();
-    for &mu in &MUS {
-        let crit = 11000.0 - 30000.0 * mu;
-        let result = if mu == 0.05 {
-            json!({"bracket": null, "class_lo": "bouncing", "class_hi": "bouncing",
-                   "drops_used": 4, "non_monotone": false,
-                   "scanned": [[2000.0, "bouncing"], [12000.0, "bouncing"]],
-                   "note": "no whirl in range"})
-        } else {
-            json!({"bracket": [crit - 400.0, crit + 300.0], "class_lo": "pendulum",
-                   "class_hi": "backward_whirl", "drops_used": 9, "non_monotone": mu == 0.2,
-                   "scanned": [[2000.0, "pendulum"], [12000.0, "backward_whirl"]], "note": null})
-        };
-        critical.push(json!({"mu": mu, "result": result}));
-    }
+    let critical: Vec<CriticalRow> = MUS.iter().map(|&mu| critical_row(mu)).collect();
     std::fs::write(
         dir.join("critical.json"),
         serde_json::to_string_pretty(&critical).unwrap(),
@@ -114,6 +102,43 @@ pub fn write_synthetic(dir: &Path, orbits: usize) {
                           "orbit": {"clearance_m": c, "samples": samples}});
         std::fs::write(odir.join(format!("orbit_{k}.json")), file.to_string()).unwrap();
     }
+}
+
+/// A synthetic critical-speed row: no whirl at mu 0.05, two whirl intervals at mu 0.2, one
+/// to the range top otherwise.
+fn critical_row(mu: f64) -> CriticalRow {
+    let crit = 11000.0 - 30000.0 * mu;
+    let o = CriticalOptions {
+        from_rpm: 1000.0,
+        to_rpm: 12000.0,
+        resolution_rpm: 250.0,
+        tol_rpm: 25.0,
+        duration_s: 1.0,
+    };
+    let (onset, intervals, top) = if mu == 0.05 {
+        (None, vec![], false)
+    } else if mu == 0.2 {
+        (Some(crit), vec![[crit, 7000.0], [9000.0, 12000.0]], true)
+    } else {
+        (Some(crit), vec![[crit, 12000.0]], true)
+    };
+    SearchResult {
+        onset_rpm: onset,
+        bracket_rpm: onset.map(|c| [c - 20.0, c]),
+        class_below: onset.map(|_| OrbitClass::Pendulum),
+        class_above: onset.map(|_| OrbitClass::BackwardWhirl),
+        whirl_intervals_rpm: intervals,
+        whirl_at_range_top: top,
+        converged: true,
+        scan: vec![Probe {
+            speed_rpm: 1000.0,
+            class: Some(OrbitClass::Pendulum),
+            error: None,
+        }],
+        bisections: vec![],
+        note: String::new(),
+    }
+    .into_row(mu, &o, "abc".into())
 }
 
 #[test]
@@ -182,10 +207,11 @@ fn render_all_writes_every_chart_as_png_and_svg() {
             "fig4_critical",
             vec![
                 "friction coefficient",
-                "critical whirl speed (r/min)",
-                "pendulum vibration",
-                "backward whirl",
-                "no whirl up to",
+                "release speed (r/min)",
+                "onset of sustained whirl",
+                "whirl interval",
+                "whirl to the range top",
+                "no whirl in range",
             ],
         ),
         (
@@ -252,9 +278,17 @@ fn extreme_values_neither_panic_nor_hang() {
         r#"{"key":"d","index":3,"inputs":{"speed_rpm":2000,"mu":0.2},"status":"ok","record":{"class":"bouncing","max_contact_force_n":-1.7e308,"peak_heat_power_w":1.0}}"#,
     ];
     std::fs::write(dir.join("points.jsonl"), lines.join("\n")).unwrap();
+    // Extreme speeds in every field the chart reads.
+    let mut a = critical_row(0.1);
+    a.onset_rpm = Some(1.7e308);
+    a.bracket_rpm = Some([1.7e308, -1.7e308]);
+    a.whirl_intervals_rpm = vec![[-1.7e308, 1.7e308]];
+    a.to_rpm = 1.7e308;
+    let mut b = critical_row(0.05);
+    b.to_rpm = f64::MAX;
     std::fs::write(
         dir.join("critical.json"),
-        r#"[{"mu":0.1,"result":{"bracket":[1.7e308,-1.7e308],"scanned":[]}},{"mu":0.2,"result":{"bracket":null,"class_lo":"backward_whirl","scanned":[]}}]"#,
+        serde_json::to_string(&[a, b]).unwrap(),
     )
     .unwrap();
     let odir = dir.join("orbits");

@@ -15,7 +15,7 @@ pub mod hertz;
 pub mod quasi_static;
 
 use crate::ode::{OdeSystem, StiffJacobian, MAX_GUARDS};
-use crate::scene::{FrictionLaw, Scene};
+use crate::scene::{FrictionLaw, Scene, SupportDamper};
 pub use friction::Slip;
 use std::cell::RefCell;
 
@@ -125,7 +125,8 @@ pub struct DropSystem {
     k2: f64,
     e2: f64,
     c2: f64,
-    /// Tangential support damping (N s/m): c2 with `support_damping_isotropic`, else 0.
+    /// Tangential support damping (N s/m): c2 with the isotropic support damper (the
+    /// default), 0 with `radial_only` (see [`crate::scene::SupportDamper`]).
     c2_t: f64,
     mu_d: f64,
     mu_s: f64,
@@ -223,10 +224,9 @@ impl DropSystem {
             k2: scene.support_stiffness_n_per_m_e,
             e2: scene.support_exponent,
             c2: scene.support_damping_n_s_per_m,
-            c2_t: if scene.support_damping_isotropic {
-                scene.support_damping_n_s_per_m
-            } else {
-                0.0
+            c2_t: match scene.support_damper {
+                SupportDamper::Isotropic => scene.support_damping_n_s_per_m,
+                SupportDamper::RadialOnly => 0.0,
             },
             mu_d: scene.mu_dynamic,
             mu_s: scene.mu_static(),

@@ -96,6 +96,8 @@ impl<const N: usize> StepCore<N> {
         mut attempt: impl FnMut(&mut Self, f64) -> (T, f64),
     ) -> Result<(T, f64), SolveError> {
         let mut rejected_last = false;
+        // The step the history proposes, before any cap.
+        let proposal = self.h;
         loop {
             if self.stats.steps + self.stats.rejected >= self.ctl.max_attempts {
                 return Err(SolveError::StepBudget {
@@ -121,6 +123,12 @@ impl<const N: usize> StepCore<N> {
                     let mut h_new = h / fac;
                     if rejected_last {
                         h_new = h_new.min(h);
+                    } else if h < proposal {
+                        // A step shortened by the cap (to meet an end time or the system's
+                        // largest step) says nothing against the proposal; without this, a
+                        // last step cut to a few femtoseconds by rounding would leave the
+                        // next call starting below `h_min` (a step-size underflow).
+                        h_new = h_new.max(proposal);
                     }
                     self.err_old = err.max(1e-4);
                     self.h = h_new;
@@ -193,9 +201,12 @@ mod tests {
             .control(&LAW, 0.0, 1.0, |_, _| ((), errs.next().unwrap()))
             .unwrap();
         assert!((h / h0 - 0.04).abs() < 1e-12);
-        // The cap bounds the attempt without changing the history's growth rule.
+        // The cap bounds the attempt without shrinking the proposal: a step cut short to meet
+        // an end time does not leave the next one tiny.
+        let h0 = c.h;
         let (_, h) = c.control(&LAW, 0.0, 1e-9, |_, _| ((), 0.5)).unwrap();
         assert_eq!(h, 1e-9);
+        assert_eq!(c.h, h0);
     }
 
     #[test]

@@ -1,0 +1,348 @@
+//! Fig. 4: the critical speed of backward whirl against the friction coefficient.
+//!
+//! Drawn from `critical.json` ([`CriticalRow`]) and, when the sweep ran a probability
+//! ensemble, its `probability/contours.json`:
+//!
+//! - the **onset** of sustained whirl per friction coefficient as one curve (dots joined
+//!   between neighbouring coefficients that both whirl in the range); an onset found already
+//!   at the lowest scanned speed carries a downward arrow (at or below it);
+//! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
+//!   to the top of the searched range;
+//! - **no whirl in range** as an open triangle at the range top;
+//! - the **whirl-probability band** over uncontrolled release conditions: P(whirl) from 10 %
+//!   to 90 % shaded, 50 % dashed. Near the boundary the outcome is a probability; the single
+//!   symmetric drops of the curve are one sample of it.
+//!
+//! The speed axis starts at 0. Grid classes are not drawn here (the class map is its own
+//! chart).
+
+use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use crate::charts::{arrow, clamp_value, legend, triangle_up, Mark, BAND, MU_DESC};
+use crate::critical::CriticalRow;
+use crate::ensemble::ContoursFile;
+use crate::render::{
+    chart_header, chart_mesh, chart_quantity, chart_text_style, DrawResult, Figure, TITLE_BAND,
+    TITLE_FONT, X_LABEL_AREA, Y_LABEL_AREA,
+};
+
+/// The probability band's colour.
+const PROB: RGBColor = RGBColor(31, 119, 180);
+/// The "no whirl in range" marker's colour.
+const NONE_MARK: RGBColor = RGBColor(90, 90, 90);
+
+/// One friction coefficient's band ends from the ensemble (r/min): P10, P50, P90, each
+/// clipped to the ensemble's speed range (`None` only without any finished member).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BandPoint {
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Speeds where P(whirl) first reaches 10 %, 50 % and 90 %.
+    pub p: [f64; 3],
+    /// Whether each level is reached inside the ensemble's speed range (false: clipped to
+    /// the range top).
+    pub reached: [bool; 3],
+}
+
+/// The band ends of every group of `contours` that has a `mu` input and the three levels
+/// 0.1, 0.5, 0.9; groups without them are skipped.
+pub fn band_points(contours: &ContoursFile) -> Vec<BandPoint> {
+    let mut out: Vec<BandPoint> = contours
+        .groups
+        .iter()
+        .filter_map(|g| {
+            let mu = *g.inputs.get("mu").or_else(|| g.inputs.get("mu_dynamic"))?;
+            let lo = *g.speeds_rpm.first()?;
+            let hi = *g.speeds_rpm.last()?;
+            let p0 = g.p_whirl.iter().flatten().next().copied()?;
+            let mut p = [0.0; 3];
+            let mut reached = [false; 3];
+            for (k, level) in [0.1, 0.5, 0.9].into_iter().enumerate() {
+                let c = g.levels.iter().find(|c| (c.level - level).abs() < 1e-9)?;
+                (p[k], reached[k]) = match c.speed_rpm {
+                    Some(s) => (s, true),
+                    // Reached already at the lowest speed, or never in the range.
+                    None if p0 >= level => (lo, true),
+                    None => (hi, false),
+                };
+            }
+            Some(BandPoint { mu, p, reached })
+        })
+        .collect();
+    out.sort_by(|a, b| a.mu.total_cmp(&b.mu));
+    out
+}
+
+/// Fig. 4 as a [`Figure`].
+pub struct Fig4<'a> {
+    /// The critical-speed rows (any order).
+    pub rows: &'a [CriticalRow],
+    /// The probability band, when the sweep ran an ensemble.
+    pub band: Option<(&'a [BandPoint], String)>,
+    /// The chart title.
+    pub title: String,
+}
+
+impl Figure for Fig4<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let mut rows: Vec<&CriticalRow> = self.rows.iter().filter(|r| r.mu.is_finite()).collect();
+        rows.sort_by(|a, b| a.mu.total_cmp(&b.mu));
+        let band: &[BandPoint] = self.band.as_ref().map_or(&[], |b| b.0);
+
+        let mus: Vec<f64> = rows
+            .iter()
+            .map(|r| r.mu)
+            .chain(band.iter().map(|b| b.mu))
+            .collect();
+        let (mu_lo, mu_hi) = mus
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &m| {
+                (a.min(m), b.max(m))
+            });
+        let (mu_lo, mu_hi) = if mu_lo.is_finite() {
+            (mu_lo, mu_hi)
+        } else {
+            (0.0, 1.0)
+        };
+        let pad = ((mu_hi - mu_lo) * 0.06).max(0.02);
+        let (x0, x1) = ((mu_lo - pad).max(0.0), mu_hi + pad);
+        let top = rows
+            .iter()
+            .map(|r| clamp_value(r.to_rpm))
+            .chain(band.iter().map(|b| b.p[2]))
+            .fold(0.0_f64, f64::max)
+            .max(1.0);
+        let y1 = top * 1.12;
+
+        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
+        let (_, bh) = body.dim_in_pixel();
+        let (plot_area, legend_band) = body.split_vertically(bh.saturating_sub(64));
+        let mut chart = ChartBuilder::on(&plot_area)
+            .margin_top(12)
+            .margin_left(14)
+            .margin_right(34)
+            .margin_bottom(4)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
+            .build_cartesian_2d(x0..x1, 0.0..y1)?;
+        chart_mesh(&mut chart, MU_DESC, "release speed (r/min)", 10, 8)?;
+
+        // The probability band first, under everything else.
+        if band.len() >= 2 {
+            let poly: Vec<(f64, f64)> = band
+                .iter()
+                .map(|b| (b.mu, b.p[0]))
+                .chain(band.iter().rev().map(|b| (b.mu, b.p[2])))
+                .collect();
+            chart.draw_series([Polygon::new(poly, PROB.mix(0.16).filled())])?;
+            for k in [0, 2] {
+                chart.draw_series([PathElement::new(
+                    band.iter().map(|b| (b.mu, b.p[k])).collect::<Vec<_>>(),
+                    PROB.mix(0.5).stroke_width(1),
+                )])?;
+            }
+            chart.draw_series([DashedPathElement::new(
+                band.iter().map(|b| (b.mu, b.p[1])).collect::<Vec<_>>(),
+                8,
+                5,
+                PROB.stroke_width(2),
+            )])?;
+        }
+
+        let pa = chart.plotting_area();
+        let base = pa.get_base_pixel();
+        let px = |x: f64, y: f64| {
+            let p = chart.backend_coord(&(x, y));
+            (p.0 - base.0, p.1 - base.1)
+        };
+        let canvas = pa.strip_coord_spec();
+
+        // The band's 50 % points: filled where the ensemble reached 50 %, open where it did not
+        // within its speed range (the point then sits at the ensemble's top speed).
+        let mut any_clipped = false;
+        if band.len() >= 2 {
+            for b in band {
+                let p = px(b.mu, b.p[1]);
+                if b.reached[1] {
+                    canvas.draw(&Circle::new(p, 4, PROB.filled()))?;
+                } else {
+                    any_clipped = true;
+                    canvas.draw(&Circle::new(p, 5, WHITE.filled()))?;
+                    canvas.draw(&Circle::new(p, 5, PROB.stroke_width(2)))?;
+                }
+            }
+        }
+
+        // Whirl intervals.
+        let mut any_open_top = false;
+        for r in &rows {
+            for (k, [a, b]) in r.whirl_intervals_rpm.iter().enumerate() {
+                let last = k + 1 == r.whirl_intervals_rpm.len();
+                let open = last && r.whirl_at_range_top;
+                let b = if open { r.to_rpm } else { *b };
+                let (pa_, pb) = (px(r.mu, clamp_value(*a)), px(r.mu, clamp_value(b)));
+                let (y_top, y_bot) = (pb.1.min(pa_.1), pb.1.max(pa_.1).max(pb.1.min(pa_.1) + 3));
+                canvas.draw(&Rectangle::new(
+                    [(pa_.0 - 8, y_top), (pa_.0 + 8, y_bot)],
+                    BAND.mix(0.28).filled(),
+                ))?;
+                if open {
+                    any_open_top = true;
+                    arrow(&canvas, (pb.0, pb.1 - 2), true, BAND)?;
+                }
+            }
+        }
+
+        // The onset curve: joined between neighbours that both whirl in the range.
+        let onsets: Vec<Option<(f64, f64)>> = rows
+            .iter()
+            .map(|r| r.onset_rpm.map(|o| (r.mu, clamp_value(o))))
+            .collect();
+        for w in onsets.windows(2) {
+            if let [Some(a), Some(b)] = w {
+                canvas.draw(&PathElement::new(
+                    vec![px(a.0, a.1), px(b.0, b.1)],
+                    BAND.stroke_width(3),
+                ))?;
+            }
+        }
+        let mut any_below = false;
+        for (r, o) in rows.iter().zip(&onsets) {
+            let Some((mu, s)) = o else { continue };
+            let p = px(*mu, *s);
+            canvas.draw(&Circle::new(p, 6, BAND.filled()))?;
+            canvas.draw(&Circle::new(p, 6, WHITE.stroke_width(1)))?;
+            if r.bracket_rpm.is_none() {
+                // Whirl already at the lowest scanned speed: the onset is at or below it.
+                any_below = true;
+                arrow(&canvas, (p.0 + 14, p.1 - 10), false, BAND)?;
+            }
+        }
+
+        // No whirl in the range: a marker at the range top.
+        let mut any_none = false;
+        for r in rows.iter().filter(|r| r.whirl_intervals_rpm.is_empty()) {
+            if r.scan.iter().all(|p| p.class.is_none()) {
+                continue; // nothing decided (every drop failed): nothing to mark
+            }
+            any_none = true;
+            triangle_up(&canvas, px(r.mu, clamp_value(r.to_rpm)), 8, NONE_MARK)?;
+        }
+        // The top of the searched range, as a faint line with its value.
+        if let Some(t) = rows.iter().map(|r| clamp_value(r.to_rpm)).reduce(f64::max) {
+            let (a, b) = (px(x0, t), px(x1, t));
+            canvas.draw(&DashedPathElement::new(
+                vec![a, b],
+                4,
+                4,
+                NONE_MARK.mix(0.6).stroke_width(1),
+            ))?;
+            canvas.draw_text(
+                &format!("top of the searched range, {} r/min", chart_quantity(t)),
+                &chart_text_style(13.0)
+                    .color(&NONE_MARK)
+                    .pos(Pos::new(HPos::Left, VPos::Bottom)),
+                (a.0 + 6, a.1 - 12),
+            )?;
+        }
+
+        let mut entries = vec![
+            (Mark::Line(BAND), "onset of sustained whirl".to_string()),
+            (
+                Mark::Swatch(BAND.mix(0.28).to_rgba().into_rgb()),
+                "whirl interval".to_string(),
+            ),
+        ];
+        if any_open_top {
+            entries.push((Mark::ArrowUp(BAND), "whirl to the range top".to_string()));
+        }
+        if any_below {
+            entries.push((
+                Mark::ArrowDown(BAND),
+                "onset at or below the lowest speed".to_string(),
+            ));
+        }
+        if any_none {
+            entries.push((Mark::TriangleUp(NONE_MARK), "no whirl in range".to_string()));
+        }
+        if let Some((b, label)) = &self.band {
+            if b.len() >= 2 {
+                entries.push((Mark::Fill(PROB), format!("P(whirl) 10-90 % {label}")));
+                entries.push((Mark::Dashed(PROB), "P(whirl) = 50 %".to_string()));
+                if any_clipped {
+                    entries.push((
+                        Mark::OpenDot(PROB),
+                        "50 % not reached by the ensemble's top speed".to_string(),
+                    ));
+                }
+            }
+        }
+        legend(&legend_band, &entries)
+    }
+}
+
+/// Converts an RGBA colour back to RGB (for swatches of mixed colours).
+trait IntoRgb {
+    fn into_rgb(self) -> RGBColor;
+}
+
+impl IntoRgb for RGBAColor {
+    fn into_rgb(self) -> RGBColor {
+        // Blend over white, as the chart does.
+        let a = self.3;
+        let mix = |c: u8| (c as f64 * a + 255.0 * (1.0 - a)).round() as u8;
+        RGBColor(mix(self.0), mix(self.1), mix(self.2))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ensemble::{ContourGroup, LevelCrossing};
+    use std::collections::BTreeMap;
+
+    fn group(mu: f64, p: &[f64], crossings: [Option<f64>; 3]) -> ContourGroup {
+        ContourGroup {
+            inputs: BTreeMap::from([("mu".to_string(), mu)]),
+            speeds_rpm: (0..p.len()).map(|i| 2000.0 + 2000.0 * i as f64).collect(),
+            p_whirl: p.iter().map(|v| Some(*v)).collect(),
+            levels: [0.1, 0.5, 0.9]
+                .iter()
+                .zip(crossings)
+                .map(|(&level, s)| LevelCrossing {
+                    level,
+                    speed_rpm: s,
+                    speed_lo_rpm: None,
+                    speed_hi_rpm: None,
+                    note: String::new(),
+                })
+                .collect(),
+            non_monotone: false,
+        }
+    }
+
+    #[test]
+    fn band_ends_are_clipped_to_the_ensemble_range() {
+        let file = ContoursFile {
+            name: "t".into(),
+            members: 8,
+            confidence: 0.95,
+            groups: vec![
+                group(0.4, &[0.2, 0.6, 1.0], [None, Some(3500.0), Some(5000.0)]),
+                group(0.3, &[0.0, 0.0, 0.3], [Some(5300.0), None, None]),
+            ],
+        };
+        let b = band_points(&file);
+        assert_eq!(b.len(), 2);
+        assert_eq!(b[0].mu, 0.3);
+        // Never reaching 50 % or 90 %: clipped to the top, marked not reached.
+        assert_eq!(b[0].p, [5300.0, 6000.0, 6000.0]);
+        assert_eq!(b[0].reached, [true, false, false]);
+        // Already above 10 % at the lowest speed: the band starts there.
+        assert_eq!(b[1].p, [2000.0, 3500.0, 5000.0]);
+        assert_eq!(b[1].reached, [true, true, true]);
+    }
+}
