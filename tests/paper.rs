@@ -34,8 +34,8 @@ fn first_contact_force_is_within_ten_percent_of_the_papers_900_n() {
 
 #[test]
 fn at_8000_rpm_low_friction_gives_pendulum_vibration() {
-    // Fig. 3 (a)-(e): pendulum vibration for mu <= 0.25. One second of simulated time, as
-    // the classifier's window is its second half.
+    // Fig. 3 (a)-(e): pendulum vibration for mu <= 0.25. One second of simulated time; the
+    // classifier decides on the final 0.25 s.
     for mu in [0.05, 0.1, 0.15, 0.2, 0.25] {
         let r = drop(8000.0, mu, 1.0);
         assert_eq!(r.class, OrbitClass::Pendulum, "mu {mu}: {:?}", r.features);
@@ -44,8 +44,8 @@ fn at_8000_rpm_low_friction_gives_pendulum_vibration() {
 
 #[test]
 fn high_friction_at_8000_rpm_gives_backward_whirl() {
-    // The paper's mechanism: friction drives the contact point against the spin. Our
-    // boundary lies between 0.3 and 0.4 at 8000 r/min (README: what mu = 0.3 gives).
+    // The paper's mechanism: friction drives the contact point against the spin. The
+    // symmetric release's threshold lies between mu 0.31 and 0.315 (docs/whirl-physics.md).
     let r = drop(8000.0, 0.4, 1.0);
     assert_eq!(r.class, OrbitClass::BackwardWhirl);
     assert!(r.whirl_frequency_hz < 0.0);

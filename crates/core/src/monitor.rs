@@ -601,6 +601,12 @@ impl Monitor {
                     x_rel_m: y[XR] - y[XB],
                     y_rel_m: y[YR] - y[YB],
                     contact_force_n: f.normal_n.max(0.0),
+                    x_race_m: y[XB],
+                    y_race_m: y[YB],
+                    slip_m_s: f.v_rel_m_s,
+                    heat_power_w: f.friction_power_w + f.bearing_power_w,
+                    rotor_speed_rad_s: y[WR],
+                    race_speed_rad_s: y[WB],
                 });
                 self.orbit_last_t = t;
             }

@@ -446,7 +446,7 @@ const CONTOUR: RGBColor = RGBColor(25, 25, 25);
 pub(crate) const BAND: RGBColor = RGBColor(214, 39, 40);
 
 /// The colour of each class on the class map and Fig. 4.
-pub(crate) fn class_colour(c: OrbitClass) -> RGBColor {
+pub fn class_colour(c: OrbitClass) -> RGBColor {
     match c {
         OrbitClass::Pendulum => RGBColor(31, 119, 180),
         OrbitClass::Bouncing => RGBColor(255, 157, 40),
@@ -464,14 +464,20 @@ const ALL_CLASSES: [OrbitClass; 5] = [
     OrbitClass::Unresolved,
 ];
 
-/// A legend entry's mark.
+/// A legend entry's mark (see [`legend`]).
 #[derive(Clone, Copy)]
-pub(crate) enum Mark {
+pub enum Mark {
+    /// A filled box.
     Swatch(RGBColor),
+    /// A hatched box (the other diagonal when true).
     Hatch(bool),
+    /// A failed-point cross.
     Failed,
+    /// A solid line.
     Line(RGBColor),
+    /// A dashed line.
     Dashed(RGBColor),
+    /// A filled dot.
     Dot(RGBColor),
     /// An open triangle pointing up: "no whirl up to the range top".
     TriangleUp(RGBColor),
@@ -562,7 +568,7 @@ pub(crate) fn triangle_up<DB: DrawingBackend>(
 }
 
 /// Draws a legend centred in `area`: one row, or more if the entries do not fit its width.
-pub(crate) fn legend<DB: DrawingBackend>(
+pub fn legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[(Mark, String)],
 ) -> DrawResult<DB> {

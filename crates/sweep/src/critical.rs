@@ -161,6 +161,16 @@ impl CriticalOptions {
     }
 }
 
+/// A number for messages: plain when of ordinary size, in exponent form otherwise (so
+/// 1e-300 is not printed as three hundred zeros).
+fn num(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-3..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
 /// Checks a search range: `from_rpm` in [0, 1e6), `to_rpm` in (`from_rpm`, 1e6],
 /// `resolution_rpm` in [1, 1e5] with at most 10 000 lattice steps in the range, and `tol_rpm`
 /// in [0.01, `resolution_rpm`]. The error names the field.
@@ -173,28 +183,28 @@ pub fn check_range(
     if !(from_rpm.is_finite() && (0.0..MAX_SPEED_RPM).contains(&from_rpm)) {
         return Err(InvalidParameter::new(
             "from_rpm",
-            from_rpm,
+            num(from_rpm),
             "[0, 1e6) r/min",
         ));
     }
     if !(to_rpm.is_finite() && to_rpm > from_rpm && to_rpm <= MAX_SPEED_RPM) {
         return Err(InvalidParameter::new(
             "to_rpm",
-            to_rpm,
+            num(to_rpm),
             &format!("({from_rpm}, 1e6] r/min (above from_rpm)"),
         ));
     }
     if !(resolution_rpm.is_finite() && (1.0..=1e5).contains(&resolution_rpm)) {
         return Err(InvalidParameter::new(
             "resolution_rpm",
-            resolution_rpm,
+            num(resolution_rpm),
             "[1, 1e5] r/min",
         ));
     }
     if !((to_rpm - from_rpm) / resolution_rpm <= MAX_SCAN_POINTS) {
         return Err(InvalidParameter::new(
             "resolution_rpm",
-            resolution_rpm,
+            num(resolution_rpm),
             &format!(
                 ">= {} r/min for this range (at most 10000 scan points)",
                 (to_rpm - from_rpm) / MAX_SCAN_POINTS
@@ -204,7 +214,7 @@ pub fn check_range(
     if !(tol_rpm.is_finite() && tol_rpm >= 0.01 && tol_rpm <= resolution_rpm) {
         return Err(InvalidParameter::new(
             "tol_rpm",
-            tol_rpm,
+            num(tol_rpm),
             &format!("[0.01, {resolution_rpm}] r/min (at most the resolution)"),
         ));
     }

@@ -258,19 +258,19 @@ pub(crate) fn orbit_panel<DB: DrawingBackend>(
 }
 
 /// Figure title font size (px).
-pub(crate) const TITLE_FONT: f64 = 26.0;
+pub const TITLE_FONT: f64 = 26.0;
 /// Panel caption font size (px).
-pub(crate) const CAPTION_FONT: f64 = 19.0;
+pub const CAPTION_FONT: f64 = 19.0;
 /// Axis description font size (px).
-pub(crate) const AXIS_DESC_FONT: f64 = 17.0;
+pub const AXIS_DESC_FONT: f64 = 17.0;
 /// Tick label and legend font size (px).
-pub(crate) const TICK_FONT: f64 = 15.0;
+pub const TICK_FONT: f64 = 15.0;
 /// Height of the band holding the figure title (px).
-pub(crate) const TITLE_BAND: u32 = 50;
+pub const TITLE_BAND: u32 = 50;
 /// Space for the x tick labels and axis description below a plot (px).
-pub(crate) const X_LABEL_AREA: u32 = 58;
+pub const X_LABEL_AREA: u32 = 58;
 /// Space for the y tick labels and axis description left of a plot (px).
-pub(crate) const Y_LABEL_AREA: u32 = 82;
+pub const Y_LABEL_AREA: u32 = 82;
 
 const TEXT_COLOUR: RGBColor = RGBColor(30, 30, 30);
 pub(crate) const AXIS_COLOUR: RGBColor = RGBColor(90, 90, 90);
@@ -614,15 +614,16 @@ impl OrbitFigure<'_> {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Crate-internal access to the shared styling helpers, for the design charts (`crate::charts`).
+// The shared styling helpers, for the design charts (`crate::charts`) and for studies that
+// draw their own figures (the examples).
 
 /// The embedded-font text style of `size` px in the chart text colour.
-pub(crate) fn chart_text_style(size: f64) -> TextStyle<'static> {
+pub fn chart_text_style(size: f64) -> TextStyle<'static> {
     text_style(size)
 }
 
 /// Splits a titled band off the top of `area` (see `with_header`); returns the rest.
-pub(crate) fn chart_header<DB: DrawingBackend>(
+pub fn chart_header<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     height: u32,
     text: &str,
@@ -632,7 +633,7 @@ pub(crate) fn chart_header<DB: DrawingBackend>(
 }
 
 /// The common axis styling (see `draw_mesh`).
-pub(crate) fn chart_mesh<DB: DrawingBackend>(
+pub fn chart_mesh<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     x_desc: &str,
     y_desc: &str,
@@ -643,12 +644,12 @@ pub(crate) fn chart_mesh<DB: DrawingBackend>(
 }
 
 /// A short tick-label formatter for an axis spanning `span` (see `tick_formatter`).
-pub(crate) fn chart_tick_formatter(span: f64) -> impl Fn(&f64) -> String {
+pub fn chart_tick_formatter(span: f64) -> impl Fn(&f64) -> String {
     tick_formatter(span)
 }
 
 /// `value` with about three significant digits (see `format_quantity`).
-pub(crate) fn chart_quantity(value: f64) -> String {
+pub fn chart_quantity(value: f64) -> String {
     format_quantity(value)
 }
 
@@ -662,6 +663,7 @@ mod tests {
             x_rel_m: 0.0,
             y_rel_m: 0.0,
             contact_force_n: f,
+            ..Default::default()
         }
     }
 

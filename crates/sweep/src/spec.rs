@@ -886,6 +886,23 @@ mod tests {
         assert!(e.contains("critical.speed_rpm"), "{e}");
         let e = err(|v| v["critical"]["tol_rpm"] = Value::from(0));
         assert!(e.contains("critical.tol_rpm = 0"), "{e}");
+        // Ranges that would run forever or nothing at all are refused before any drop.
+        let e = err(|v| v["critical"]["tol_rpm"] = Value::from(1e-300));
+        assert!(e.contains("critical.tol_rpm = 1e-300"), "{e}");
+        let e = err(|v| v["critical"]["speed_rpm"] = serde_json::json!({"from": 0, "to": 1e308}));
+        assert!(e.contains("critical.speed_rpm.to"), "{e}");
+        let e = err(|v| v["critical"]["speed_rpm"] = serde_json::json!({"from": -5, "to": 100}));
+        assert!(e.contains("critical.speed_rpm.from = -5"), "{e}");
+        let e = err(|v| v["critical"]["resolution_rpm"] = Value::from(0.5));
+        assert!(e.contains("critical.resolution_rpm = 0.5"), "{e}");
+        let e = err(|v| v["critical"]["mu"] = serde_json::json!([0.3, 0.3]));
+        assert!(e.contains("critical.mu = 0.3") && e.contains("once"), "{e}");
+        // A probability section is checked with the sweep (its draws against every cell).
+        let e = err(|v| {
+            v["probability"] = serde_json::json!({"axes": {"mu": [0.3]},
+                "ensemble": {"members": 0, "seed": 1}})
+        });
+        assert!(e.contains("members"), "{e}");
         let e = err(|v| v["name"] = Value::from("../x"));
         assert!(e.contains("name"), "{e}");
         let e = err(|v| v["axes"]["mu_dynamic"] = serde_json::json!([0.2]));

@@ -63,6 +63,7 @@ fn synthetic_orbit(n: usize) -> Orbit {
                 x_rel_m: radius * angle.cos(),
                 y_rel_m: radius * angle.sin(),
                 contact_force_n: force,
+                ..Default::default()
             }
         })
         .collect();
@@ -157,6 +158,7 @@ fn empty_and_non_finite_orbits_still_render() {
                 x_rel_m: f64::NAN,
                 y_rel_m: f64::NAN,
                 contact_force_n: f64::NAN,
+                ..Default::default()
             };
             3
         ],
