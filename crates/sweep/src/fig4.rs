@@ -250,7 +250,10 @@ impl Figure for Fig4<'_> {
         }
 
         let mut entries = vec![
-            (Mark::Line(BAND), "onset of sustained whirl".to_string()),
+            (
+                Mark::Line(BAND),
+                "onset of sustained whirl (symmetric release)".to_string(),
+            ),
             (
                 Mark::Swatch(BAND.mix(0.28).to_rgba().into_rgb()),
                 "whirl interval".to_string(),
