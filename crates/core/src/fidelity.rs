@@ -1,28 +1,30 @@
 //! Fidelity presets: named trade-offs between speed and accuracy, chosen from the measured
-//! work-precision curve of `whirlmap accuracy` (README, "Speed against accuracy").
+//! work-precision study of `whirlmap accuracy` (`results/accuracy/`, docs/performance.md).
 //!
-//! A preset sets only what is numerics or a documented reduced model: the tolerance, the
-//! Runge-Kutta pair, and whether the race's translation is treated as massless. It leaves the
-//! physics a user chose (friction law, drag, every parameter) alone. Without a preset a drop
-//! runs with the scene's own settings, which is what every earlier output used.
+//! A preset sets only numerics: the tolerance, the integrator, the free-flight gap bound and
+//! the race's tolerance scale (and the full model: it switches the quasi-static race off). It
+//! leaves the physics a user chose (friction law, drag, every parameter) alone. Without a
+//! preset a drop runs with the scene's own solver settings, whose defaults are `standard`.
 
 use crate::error::InvalidParameter;
-use crate::scene::{Method, Scene};
+use crate::scene::{Method, Scene, SolverSettings};
 use serde::{Deserialize, Serialize};
 
 /// A named speed/accuracy trade-off.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
-    /// Fast screening: massless race translation (`quasi_static_race`), rtol 1e-4. About 15x
-    /// fewer RHS evaluations than `standard`; forces about 1 % high (the race's mass is
-    /// missing from the impacts) and whirl frequencies off by up to tens of percent.
+    /// Screening: the `standard` numerics at rtol 3e-4. In the work-precision study's five
+    /// cases: forces and peak heat within 0.2 %, whirl frequency within 2 %, every class
+    /// right, about 20 % cheaper than `standard`.
     Draft,
-    /// Design work: the full paper model at rtol 1e-5 (the scene default), whose force and
-    /// heat errors are far below 0.1 % in every measured case.
+    /// Design work, and the scene default: ROS34PW2 (linearly implicit, L-stable) with the
+    /// free-flight gap bound and the race's absolute tolerances x1000, at rtol 1e-4; the
+    /// cheapest setting of the study within the budget (first and maximum contact force and
+    /// peak heat power within 0.1 % of `reference`, whirl frequency within 1 %, the same class).
     Standard,
-    /// The full paper model at rtol 1e-9 with DOPRI5 (the reference of the accuracy study,
-    /// where DOP853 at rtol 1e-10 confirms it).
+    /// DOPRI5 at rtol 1e-9: the reference of the accuracy and convergence studies (DOP853 at
+    /// rtol 1e-10 confirms it to 6e-6).
     Reference,
 }
 
@@ -49,23 +51,39 @@ impl Fidelity {
 
     /// The relative tolerance of the preset.
     pub fn rtol(self) -> f64 {
+        self.solver().rtol
+    }
+
+    /// The preset's integrator settings (the rest of [`SolverSettings`] keeps its defaults).
+    pub fn solver(self) -> SolverSettings {
+        let standard = SolverSettings::default();
         match self {
-            Fidelity::Draft => 1e-4,
-            Fidelity::Standard => 1e-5,
-            Fidelity::Reference => 1e-9,
+            Fidelity::Draft => SolverSettings {
+                rtol: 3e-4,
+                ..standard
+            },
+            Fidelity::Standard => standard,
+            Fidelity::Reference => SolverSettings {
+                rtol: 1e-9,
+                method: Method::Dopri5,
+                free_flight_gap_bound: false,
+                race_atol_scale: 1.0,
+                ..standard
+            },
         }
     }
 
-    /// Whether the preset treats the race's translation as massless.
-    pub fn quasi_static_race(self) -> bool {
-        matches!(self, Fidelity::Draft)
-    }
-
-    /// Sets the preset's numerics and reduced model on `scene`.
+    /// Sets the preset's numerics on `scene` (tolerance, integrator, gap bound, race
+    /// tolerance scale), and the full model (`quasi_static_race` off). The physics a user
+    /// chose stays as it is.
     pub fn apply(self, scene: &mut Scene) {
-        scene.solver.rtol = self.rtol();
-        scene.solver.method = Method::Dopri5;
-        scene.quasi_static_race = self.quasi_static_race();
+        let p = self.solver();
+        let s = &mut scene.solver;
+        s.rtol = p.rtol;
+        s.method = p.method;
+        s.free_flight_gap_bound = p.free_flight_gap_bound;
+        s.race_atol_scale = p.race_atol_scale;
+        scene.quasi_static_race = false;
     }
 
     /// A copy of `scene` with the preset applied.
@@ -110,6 +128,11 @@ mod tests {
         let e = Fidelity::parse("fast").unwrap_err();
         assert_eq!(e.field, "fidelity");
         assert!(e.to_string().contains("fast") && e.to_string().contains("draft"));
+    }
+
+    #[test]
+    fn standard_is_the_scene_default() {
+        assert_eq!(Fidelity::Standard.applied(&Scene::paper()), Scene::paper());
     }
 
     #[test]

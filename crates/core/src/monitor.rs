@@ -202,6 +202,8 @@ struct Streak {
     start_angle: f64,
     first_turn_s: f64,
     last_turn_s: f64,
+    /// The previous sample (angle, time), for turn times between samples.
+    prev: Option<(f64, f64)>,
 }
 
 impl Streak {
@@ -216,6 +218,7 @@ impl Streak {
             start_angle: f64::NAN,
             first_turn_s: f64::NAN,
             last_turn_s: f64::NAN,
+            prev: None,
         }
     }
 
@@ -226,6 +229,7 @@ impl Streak {
     }
 
     fn update(&mut self, angle: f64, t: f64, contact_s: f64) {
+        let prev = self.prev.replace((angle, t));
         if self.ref_angle.is_nan() {
             self.reset_at(angle, t, contact_s);
             return;
@@ -233,9 +237,19 @@ impl Streak {
         let d = angle - self.ref_angle;
         if d.abs() >= TAU {
             let dir = d.signum();
-            let dt = t - self.ref_t;
-            let duty = if dt > 0.0 {
-                (contact_s - self.ref_contact_s) / dt
+            // The time the angle passed the full turn, linear between this sample and the
+            // previous one (samples are a step's midpoint and end): the turn times, and so
+            // the whirl frequency, do not depend on where the steps fall.
+            let target = self.ref_angle + dir * TAU;
+            let t_turn = match prev {
+                Some((a0, t0)) if (angle - a0) * dir > 0.0 && (target - a0) * dir >= 0.0 => {
+                    t0 + (t - t0) * ((target - a0) / (angle - a0)).clamp(0.0, 1.0)
+                }
+                _ => t,
+            };
+            let dt = t_turn - self.ref_t;
+            let duty = if t > self.ref_t {
+                (contact_s - self.ref_contact_s) / (t - self.ref_t)
             } else {
                 0.0
             };
@@ -243,20 +257,19 @@ impl Streak {
             if whirl_turn && self.count * dir >= 0.0 {
                 if self.count == 0.0 {
                     self.start_angle = self.ref_angle;
-                    self.first_turn_s = t;
+                    self.first_turn_s = t_turn;
                 }
                 self.count += dir;
-                self.last_turn_s = t;
+                self.last_turn_s = t_turn;
             } else if whirl_turn {
                 self.count = dir;
                 self.start_angle = self.ref_angle;
-                self.first_turn_s = t;
-                self.last_turn_s = t;
+                self.first_turn_s = t_turn;
+                self.last_turn_s = t_turn;
             } else {
                 self.count = 0.0;
             }
-            let ref_angle = self.ref_angle + dir * TAU;
-            self.reset_at(ref_angle, t, contact_s);
+            self.reset_at(target, t_turn, contact_s);
         } else if self.count != 0.0 && d * self.count.signum() < -FRAC_PI_2 {
             self.count = 0.0;
             self.reset_at(angle, t, contact_s);

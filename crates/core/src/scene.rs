@@ -29,24 +29,16 @@ pub enum FrictionLaw {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
-    /// Dormand-Prince 5(4) with 4th-order dense output: the default.
-    #[default]
+    /// Dormand-Prince 5(4) with 4th-order dense output: the `reference` fidelity's pair.
     Dopri5,
     /// Hairer's DOP853, 8(5,3) with 7th-order dense output: the independent reference of
     /// `whirlmap accuracy` (see `ode/dop853.rs` for why it is hand-written).
     Dop853,
     /// ROS34PW2, a linearly implicit Rosenbrock-W method of order 3 (Rang and Angermann
     /// 2005) with an analytic stiff Jacobian: its step is not bounded by the light race's
-    /// contact mode (`ode/rosw.rs`).
+    /// contact mode (`ode/rosw.rs`). The default.
+    #[default]
     Ros34pw2,
-}
-
-impl Method {
-    /// True for the default (so the field is left out of the canonical JSON and the scene
-    /// hash of every existing record stays what it was).
-    pub fn is_default(&self) -> bool {
-        *self == Method::Dopri5
-    }
 }
 
 /// How the race-on-balls damper c2 of Table 4 acts on the race's velocity.
@@ -74,8 +66,8 @@ pub enum SupportDamper {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverSettings {
-    /// Relative tolerance of the 5(4) pair. Default 1e-5: first-impact and maximum forces
-    /// agree with rtol 1e-9 to 0.001 %, while rtol 1e-3 already corrupts a whirl case.
+    /// Relative tolerance. Default 1e-4 (the `standard` fidelity: forces and peak heat power
+    /// within 0.1 % of the reference, whirl frequency within 1 %; docs/performance.md).
     /// Allowed (0, 1e-2].
     pub rtol: f64,
     /// Position scale for the absolute tolerance (m): `atol = rtol * position_scale_m` on
@@ -90,47 +82,43 @@ pub struct SolverSettings {
     pub max_step_attempts: u64,
     /// Located mode switches before a typed budget error (chatter guard). Default 2 000 000.
     pub max_events: u64,
-    /// The integrator. Default `dopri5`; `dop853` is the reference integrator; `ros34pw2`
-    /// is the linearly implicit Rosenbrock-W method (README, "Speed against accuracy").
-    /// Omitted from the canonical JSON (and the hash) while it is the default.
-    #[serde(skip_serializing_if = "Method::is_default")]
+    /// The integrator. Default `ros34pw2`, the linearly implicit Rosenbrock-W method (its
+    /// step is not bounded by the light race's contact modes); `dopri5` is the explicit
+    /// Dormand-Prince 5(4) pair (the `reference` fidelity's); `dop853` the independent
+    /// reference of `whirlmap accuracy`.
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a
-    /// bound on the relative acceleration). Default false (the fixed cap alone). Omitted
-    /// from the canonical JSON while false.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    /// bound on the relative acceleration). Default true.
     pub free_flight_gap_bound: bool,
     /// Factor on the absolute tolerances of the race's translation (its centre's position
     /// and velocity). The race centre is a fast variable held by two stiff springs (its own
     /// modes at 3-16 kHz): with its support damped in every direction
-    /// (`support_damper = isotropic`, the default) and an L-stable stepper (`ros34pw2`) its local errors
-    /// decay instead of accumulating, and the default absolute tolerances (the rotor's:
-    /// `rtol * position_scale_m` on positions, `rtol * sqrt(2 g s) / 100` on velocities)
-    /// are what bound the implicit step in contact. The accuracy this costs is measured by `whirlmap accuracy`
-    /// (README, "Speed against accuracy"). Default 1; allowed [1, 1e4]. Omitted from the
-    /// canonical JSON while 1.
-    #[serde(skip_serializing_if = "is_one")]
+    /// (`support_damper = isotropic`, the default) and an L-stable stepper (`ros34pw2`) its
+    /// local errors decay instead of accumulating, and the rotor's absolute tolerances
+    /// (`rtol * position_scale_m` on positions, `rtol * sqrt(2 g s) / 100` on velocities)
+    /// would bound the implicit step in contact. Default 1000 (the `standard` fidelity; the
+    /// accuracy it costs is measured by `whirlmap accuracy`). Allowed [1, 1e4].
     pub race_atol_scale: f64,
 }
 
 // Exact comparison on purpose: only the default is left out of the JSON.
-fn is_one(v: &f64) -> bool {
-    *v == 1.0
-}
 
 impl Default for SolverSettings {
+    /// The `standard` fidelity ([`crate::Fidelity::Standard`]): ROS34PW2 with the gap bound
+    /// and the race's absolute tolerances x1000 at rtol 1e-4, the cheapest setting of the
+    /// work-precision study within the accuracy budget.
     fn default() -> Self {
         Self {
-            rtol: 1e-5,
+            rtol: 1e-4,
             position_scale_m: 1e-6,
             free_flight_max_step_s: 2e-5,
             min_step_s: 1e-13,
             max_step_attempts: 20_000_000,
             max_events: 2_000_000,
-            method: Method::Dopri5,
-            free_flight_gap_bound: false,
-            race_atol_scale: 1.0,
+            method: Method::Ros34pw2,
+            free_flight_gap_bound: true,
+            race_atol_scale: 1000.0,
         }
     }
 }
@@ -297,9 +285,6 @@ impl Scene {
         "quasi_static_race",
         "stop_speed_rpm",
         "thermal",
-        "solver.method",
-        "solver.free_flight_gap_bound",
-        "solver.race_atol_scale",
     ];
 
     /// The paper's scene: Tables 2-4 with the MODEL-NOTES defaults, 8000 r/min, mu 0.1.

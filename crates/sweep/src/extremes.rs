@@ -149,10 +149,14 @@ pub fn matrix(full: bool) -> Vec<ExtremePoint> {
     v
 }
 
-/// The energy audit bound of `physics.rs`'s extreme-input test: 1e-6 of the largest energy
-/// in play, plus 10 rtol of the drop energy m_r g s over that scale (the audit's residual
-/// is integration error that scales with rtol; 10 rtol is twice the worst ratio measured
-/// at speed 0).
+/// The energy audit bound of the extremes contract. The audit's residual is integration
+/// error, relative to the largest energy in play: about rtol of that energy, plus the error
+/// of the race's elastic energy, which is integrated to `race_atol_scale` times looser
+/// absolute tolerances: relative to the clearance, its position tolerance is
+/// `rtol * race_atol_scale * position_scale_m / clearance_m` of the drop energy m_r g s.
+/// The bound is 10 times both (at the standard numerics and speed 0, where m_r g s is the
+/// scale, the measured residual is 4.1e-3 against a bound of 7.7e-3; with spin, 1e-5 or
+/// less against 1e-3).
 pub fn audit_bound(s: &Scene, r: &DropReport) -> f64 {
     let e = &r.energy;
     let drop_energy = s.rotor_mass_kg * s.load_share * s.gravity_m_s2 * s.clearance_m;
@@ -162,7 +166,9 @@ pub fn audit_bound(s: &Scene, r: &DropReport) -> f64 {
         .max(e.final_j.abs())
         .max((e.friction_heat_j + e.damping_loss_j + e.drag_work_j).abs())
         .max(drop_energy);
-    1e-6 + 10.0 * s.solver.rtol * drop_energy / scale
+    let v = &s.solver;
+    let race = v.rtol * v.race_atol_scale * v.position_scale_m / s.clearance_m;
+    10.0 * v.rtol + 10.0 * race * drop_energy / scale
 }
 
 /// Runs one point and checks the contract.

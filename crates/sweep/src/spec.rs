@@ -765,7 +765,7 @@ mod tests {
     fn a_fidelity_preset_sets_the_base_scene_and_a_bad_one_is_named() {
         let spec = with(|v| v["fidelity"] = "draft".into()).unwrap();
         let p = &spec.points().unwrap()[0];
-        assert!(p.scene.quasi_static_race);
+        assert_eq!(p.scene.solver, Fidelity::Draft.solver());
         assert_eq!(p.scene.solver.rtol, Fidelity::Draft.rtol());
         let plain = with(|_| {}).unwrap();
         assert_eq!(plain.points().unwrap()[0].scene.solver.rtol, 1e-6);
