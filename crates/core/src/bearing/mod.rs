@@ -1,5 +1,5 @@
 //! The touchdown bearing pair's survival analysis: its geometry and ratings, the loads of its
-//! balls, their contact stress, and the counting of their load cycles.
+//! balls, their contact stress, the counting of their load cycles, and the fatigue damage.
 //!
 //! - [`geometry`]: the pair (two 71908 CD face to face), every parameter with its source, and
 //!   the ratings from ISO 281's and ISO 76's own formulas.
@@ -10,13 +10,16 @@
 //!   Kotzalas ch. 2 and 6), the ellipticity solved exactly from the complete elliptic
 //!   integrals.
 //! - [`rainflow`]: ASTM E1049 rainflow counting, streaming.
+//! - [`life`]: Lundberg-Palmgren / ISO 281 load-life and the Palmgren-Miner sum.
 
 pub mod geometry;
 pub mod hertz;
+pub mod life;
 pub mod load;
 pub mod rainflow;
 
 pub use geometry::BearingPair;
 pub use hertz::{ContactEllipse, PointContact, Race};
+pub use life::{InnerRaceFatigue, LoadClass, LoadSpectrum};
 pub use load::BallSet;
 pub use rainflow::{Cycle, Rainflow};
