@@ -367,7 +367,7 @@ fn cube_integral(a: f64, b: f64, qa: f64, qb: f64) -> f64 {
 
 /// The assumptions behind every number of a [`BearingReport`], to print beside them.
 pub fn assumptions() -> &'static str {
-    "Bearing: two 71908 CD (15 deg contact angle) face to face, 5.5 mm balls on a 51 mm pitch \
+    "Bearing (BearingPair's defaults): two 71908 CD (15 deg contact angle) face to face, 5.5 mm balls on a 51 mm pitch \
 circle (paper Table 3), 22 balls a row and groove conformities 0.52/0.53 assumed (ISO 281 \
 rating basis; not in the catalogue tables), bearing steel E = 208 GPa, nu = 0.3.
 Loads: rigid rings, zero internal clearance, no axial load (planar model; the two rows share \
@@ -424,6 +424,26 @@ mod tests {
         a.observe(2.0, 1e-6, 0.0, 10.0);
         let r = a.report();
         assert_eq!((r.samples, r.ignored_samples), (2, 2));
+    }
+
+    #[test]
+    fn a_given_support_force_sets_the_ball_loads() {
+        // The damper adds to the elastic force: the balls carry the sum.
+        let pair = BearingPair::default();
+        let mut a = BearingAnalysis::new(&pair).unwrap();
+        let r: f64 = 2e-5;
+        let elastic = pair.lumped_stiffness_n_per_m1_5 * r.powf(1.5);
+        a.observe_with_force(0.0, r, 0.0, 0.0, 1.5 * elastic);
+        let s = a.latest().unwrap();
+        let q = 1.5 * elastic
+            / (2.0
+                * 22.0
+                * super::super::load::RADIAL_INTEGRAL_ZERO_CLEARANCE
+                * 15f64.to_radians().cos());
+        assert!((s.max_ball_load_n / q - 1.0).abs() < 1e-14);
+        assert!(
+            (s.inner_pressure_pa / pair.inner_contact().max_pressure_pa(q) - 1.0).abs() < 1e-14
+        );
     }
 
     #[test]

@@ -22,8 +22,8 @@
 //!
 //! ## The numbers for the seed paper's bearing
 //! Per-ball stiffness from `k2 = 7.811e9 N/m^1.5`: `K_n = 8.46e8 N/m^1.5`. By Hertz the same
-//! geometry has `K_n = 7.23e9 N/m^1.5`, a lumped `k2 = 6.67e10 N/m^1.5`: the paper's support is
-//! 8.5 times softer than two rigid-ring 71908 CD (at one force the race moves 4.2 times as
+//! geometry has `K_n = 7.24e9 N/m^1.5`, a lumped `k2 = 6.69e10 N/m^1.5`: the paper's support is
+//! 8.6 times softer than two rigid-ring 71908 CD (at one force the race moves 4.2 times as
 //! far). The ball loads follow from the support force, not from the stiffness, so they are
 //! the same either way; only the displacement that carries a given force differs.
 
