@@ -18,9 +18,12 @@
 //! ```text
 //! Q_C  = C / (i Z J_r cos α)             the most loaded ball's load when the pair carries C
 //! N_C  = 1e6 · Z/2 (1 + γ)               over-rolling cycles in 10^6 revolutions
-//! d(Q) = (Q / Q_C)^3 / N_C               damage of one cycle whose peak is the most loaded
-//!                                        ball's load Q
+//! d(Q) = (Q / Q_C)^3 / N_C               damage of one cycle whose height is the most
+//!                                        loaded ball's load Q
 //! ```
+//!
+//! In a drop the load changes within a pass; the analysis gives each pass the cubic mean of
+//! the most loaded ball's load over it (`analysis`), which keeps this normalisation exact.
 //!
 //! A steady `F_r` gives `Q = Q_C F_r / C` at every pass and `Z/2 (1 + γ)` passes a
 //! revolution, so the damage per revolution is `(F_r / C)^3 / 1e6 = 1 / L10`.
