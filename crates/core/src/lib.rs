@@ -61,6 +61,7 @@
     clippy::needless_range_loop
 )]
 
+pub mod bearing;
 pub mod classify;
 pub mod drop;
 pub mod error;
