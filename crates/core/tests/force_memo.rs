@@ -26,8 +26,8 @@ fn bits(f: &Forces) -> Vec<u64> {
         f.bearing_power_w,
         f.damping_power_w,
     ];
-    v.extend(f.n);
-    v.extend(f.t);
+    v.extend(f.n.iter());
+    v.extend(f.t.iter());
     v.extend(f.acc);
     v.into_iter().map(f64::to_bits).collect()
 }

@@ -18,7 +18,7 @@ struct Check {
 impl Observer<DropSystem, N> for Check {
     fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
         self.seen += 1;
-        if self.seen % self.every != 0 {
+        if !self.seen.is_multiple_of(self.every) {
             return ControlFlow::Continue(());
         }
         // The sticking constraint's dependence on the state is left out by design.
@@ -56,13 +56,15 @@ impl Observer<DropSystem, N> for Check {
                 }
                 let fd = (fp[r] - fm[r]) / (2.0 * scale);
                 // Row scale: the largest analytic entry in the row over that column kind.
-                let row_max = (0..sj.len).map(|k| sj.jac[a][k].abs()).fold(1.0, f64::max);
-                let err = (sj.jac[a][b] - fd).abs() / row_max;
+                let row_max = (0..sj.len)
+                    .map(|k| sj.jac[(a, k)].abs())
+                    .fold(1.0, f64::max);
+                let err = (sj.jac[(a, b)] - fd).abs() / row_max;
                 self.worst = self.worst.max(err);
                 assert!(
                     err < 1e-4,
                     "row {r} col {c}: analytic {:e} fd {fd:e} (row max {row_max:e}), mode {:?}",
-                    sj.jac[a][b],
+                    sj.jac[(a, b)],
                     sys.mode
                 );
             }

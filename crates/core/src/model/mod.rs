@@ -17,6 +17,7 @@ pub mod quasi_static;
 use crate::ode::{OdeSystem, StiffJacobian, MAX_GUARDS};
 use crate::scene::{FrictionLaw, Scene, SupportDamper};
 pub use friction::Slip;
+use nalgebra::{Matrix2, Vector2};
 use std::cell::RefCell;
 
 /// State layout: rotor (x, y, theta), race (x, y, theta), their rates, then three energy
@@ -71,9 +72,9 @@ pub struct Mode {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Forces {
     /// Contact normal n (unit, from race centre towards rotor centre).
-    pub n: [f64; 2],
+    pub n: Vector2<f64>,
     /// Contact tangent t = (-n_y, n_x).
-    pub t: [f64; 2],
+    pub t: Vector2<f64>,
     /// |O_r - O_b| (m).
     pub dist_m: f64,
     /// Penetration delta = |d| - s (m).
@@ -306,32 +307,29 @@ impl DropSystem {
     /// the same thing when the contact carries the weight (`F_y = m g`), which is the
     /// approximation the paper made; we keep the exact form.
     #[inline]
-    fn accelerations(&self, y: &[f64; N], f: &Forces, ft: f64, support_vec: [f64; 2]) -> [f64; 6] {
-        let (n, t) = (f.n, f.t);
-        let fx = -f.normal_n * n[0] - ft * t[0];
-        let fy = -f.normal_n * n[1] - ft * t[1];
+    fn accelerations(&self, y: &[f64; N], f: &Forces, ft: f64, support: Vector2<f64>) -> [f64; 6] {
+        // The contact force on the race; the rotor gets its opposite.
+        let fc = f.normal_n * f.n + ft * f.t;
         let tau = -ft * self.r_r;
         let (ax_r, ay_r, al_r);
         if self.e == 0.0 {
             al_r = tau / self.j_r;
-            ax_r = fx / self.m_r;
-            ay_r = fy / self.m_r - self.g;
+            ax_r = -fc.x / self.m_r;
+            ay_r = -fc.y / self.m_r - self.g;
         } else {
             let (sp, cp) = (y[ix::TR] + self.phase).sin_cos();
             let w2 = y[ix::WR] * y[ix::WR];
-            al_r = (tau + self.e * (fx * sp - fy * cp)) / self.j_r;
-            ax_r = fx / self.m_r + self.e * (al_r * sp + w2 * cp);
-            ay_r = fy / self.m_r - self.g - self.e * (al_r * cp - w2 * sp);
+            al_r = (tau + self.e * (-fc.x * sp + fc.y * cp)) / self.j_r;
+            ax_r = -fc.x / self.m_r + self.e * (al_r * sp + w2 * cp);
+            ay_r = -fc.y / self.m_r - self.g - self.e * (al_r * cp - w2 * sp);
         }
         let (ax_b, ay_b) = if self.series.is_some() {
             // Massless race translation: the race centre stays at the housing centre in
             // the state; its displacement lives in the series split.
             (0.0, 0.0)
         } else {
-            (
-                (f.normal_n * n[0] + ft * t[0] + support_vec[0]) / self.m_b,
-                (f.normal_n * n[1] + ft * t[1] + support_vec[1]) / self.m_b - self.g,
-            )
+            let a = (fc + support) / self.m_b;
+            (a.x, a.y - self.g)
         };
         let al_b = (ft * self.r_b + f.drag_torque_n_m) / self.j_b;
         [ax_r, ay_r, al_r, ax_b, ay_b, al_b]
@@ -341,7 +339,7 @@ impl DropSystem {
     /// tangent turns with the contact angle, `t' = -(v_t/|d|) n`).
     #[inline]
     fn slip_acceleration(&self, f: &Forces, v_t: f64, a: &[f64; 6]) -> f64 {
-        (a[0] - a[3]) * f.t[0] + (a[1] - a[4]) * f.t[1] - v_t * f.delta_dot_m_s / f.dist_m
+        Vector2::new(a[0] - a[3], a[1] - a[4]).dot(&f.t) - v_t * f.delta_dot_m_s / f.dist_m
             + a[2] * self.r_r
             - a[5] * self.r_b
     }
@@ -388,21 +386,20 @@ impl DropSystem {
     fn fill_forces(&self, y: &[f64; N], mode: Mode, out: &mut Forces) {
         *out = Forces::default();
         let f = out;
-        let dx = y[ix::XR] - y[ix::XB];
-        let dy = y[ix::YR] - y[ix::YB];
-        let dist = (dx * dx + dy * dy).sqrt();
+        // d = O_r - O_b, n = d / |d|, t = (-n_y, n_x), w = v_r - v_b.
+        let d = Vector2::new(y[ix::XR] - y[ix::XB], y[ix::YR] - y[ix::YB]);
+        let dist = d.norm();
         f.dist_m = dist;
         f.n = if dist > 0.0 {
-            [dx / dist, dy / dist]
+            d / dist
         } else {
-            [0.0, -1.0]
+            Vector2::new(0.0, -1.0)
         };
-        f.t = [-f.n[1], f.n[0]];
-        let dvx = y[ix::VXR] - y[ix::VXB];
-        let dvy = y[ix::VYR] - y[ix::VYB];
+        f.t = Vector2::new(-f.n.y, f.n.x);
+        let w = Vector2::new(y[ix::VXR] - y[ix::VXB], y[ix::VYR] - y[ix::VYB]);
         f.delta_m = dist - self.s;
-        f.delta_dot_m_s = dvx * f.n[0] + dvy * f.n[1];
-        let v_t = dvx * f.t[0] + dvy * f.t[1];
+        f.delta_dot_m_s = w.dot(&f.n);
+        let v_t = w.dot(&f.t);
         f.v_rel_m_s = v_t + y[ix::WR] * self.r_r - y[ix::WB] * self.r_b;
         // Quasi-static race: the series springs' force and the split damper (see
         // `quasi_static`); otherwise eq. 7 between rotor and race.
@@ -421,9 +418,9 @@ impl DropSystem {
         }
 
         // Ball support: isotropic, zero clearance, eq. 7 with e = 3/2 and c2.
-        let (bx, by) = (y[ix::XB], y[ix::YB]);
-        let r = (bx * bx + by * by).sqrt();
-        let mut support_vec = [0.0; 2];
+        let b = Vector2::new(y[ix::XB], y[ix::YB]);
+        let r = b.norm();
+        let mut support_vec = Vector2::zeros();
         let mut r_dot = 0.0;
         let mut tangential_power_w = 0.0;
         if self.series.is_some() {
@@ -431,18 +428,18 @@ impl DropSystem {
             f.support_raw_n = self.f_ref_b;
             f.support_n = f.normal_n.max(0.0);
         } else if r > 0.0 {
-            let nb = [bx / r, by / r];
-            r_dot = y[ix::VXB] * nb[0] + y[ix::VYB] * nb[1];
+            let nb = b / r;
+            let vb = Vector2::new(y[ix::VXB], y[ix::VYB]);
+            r_dot = vb.dot(&nb);
             f.support_raw_n = hertz::raw_force(self.k2, self.e2, self.c2, r, r_dot);
             if mode.support {
                 f.support_n = f.support_raw_n;
-                support_vec = [-f.support_n * nb[0], -f.support_n * nb[1]];
+                support_vec = -f.support_n * nb;
                 if self.c2_t > 0.0 {
                     // Isotropic damper: c2 also on the race velocity across nb.
-                    let vt = [y[ix::VXB] - nb[0] * r_dot, y[ix::VYB] - nb[1] * r_dot];
-                    support_vec[0] -= self.c2_t * vt[0];
-                    support_vec[1] -= self.c2_t * vt[1];
-                    tangential_power_w = self.c2_t * (vt[0] * vt[0] + vt[1] * vt[1]);
+                    let vt = vb - r_dot * nb;
+                    support_vec -= self.c2_t * vt;
+                    tangential_power_w = self.c2_t * vt.norm_squared();
                 }
             }
         }
@@ -612,39 +609,43 @@ impl OdeSystem<N> for DropSystem {
     /// sticking constraint's dependence on the state.
     fn stiff_jacobian(&self, _t: f64, y: &[f64; N]) -> Option<StiffJacobian> {
         use ix::*;
+        // Blocks of the stiff set: rotor position 0..2, race position 2..4, rotor velocity
+        // 4..6, race velocity 6..8, then the rotor's (8) and the race's (9) spin.
+        const QR: usize = 0;
+        const QB: usize = 2;
+        const VR: usize = 4;
+        const VB: usize = 6;
+        const SR: usize = 8;
+        const SB: usize = 9;
         let mut sj = StiffJacobian::over(&[XR, YR, XB, YB, VXR, VYR, VXB, VYB, WR, WB]);
-        // The four positions' rows are exactly q' = v (eq. 1-6): the stepper eliminates them.
+        // The four positions' rows are exactly q' = v (eqs. 1-6): the stepper eliminates them.
         sj.kinematic = 4;
         let j = &mut sj.jac;
-        for a in 0..4 {
-            j[a][4 + a] = 1.0;
-        }
+        j.fixed_view_mut::<4, 4>(QR, VR).fill_with_identity();
         let f = self.forces(y);
+        // t = R n with R the quarter turn.
+        let quarter = Matrix2::new(0.0, -1.0, 1.0, 0.0);
         if self.mode.contact && f.dist_m > 0.0 {
             let (n, t, dist) = (f.n, f.t, f.dist_m);
-            let w = [y[VXR] - y[VXB], y[VYR] - y[VYB]];
-            let wn = w[0] * n[0] + w[1] * n[1];
-            let pw = [w[0] - n[0] * wn, w[1] - n[1] * wn];
-            // P = I - n n^T and R P with R the quarter turn (t = R n).
-            let pm = [
-                [1.0 - n[0] * n[0], -n[0] * n[1]],
-                [-n[1] * n[0], 1.0 - n[1] * n[1]],
-            ];
-            let rp = [[-pm[1][0], -pm[1][1]], [pm[0][0], pm[0][1]]];
+            let w = Vector2::new(y[VXR] - y[VXB], y[VYR] - y[VYB]);
+            // P = I - n n^T: how n turns with d; R P: how t turns.
+            let p = Matrix2::identity() - n * n.transpose();
+            let rp = quarter * p;
+            let pw = p * w;
             let (kd, c) = match &self.series {
                 Some(ss) => {
                     // Series springs: dF/dd = F / (a/e1 + b/e2); the split damper's weight
                     // w = (a/e1) / (a/e1 + b/e2) moves with d too (its slope times delta_dot
                     // joins the stiffness).
                     let sp = ss.split(f.delta_m);
-                    let (p, q) = (ss.inv_e1(), ss.inv_e2());
+                    let (pp, q) = (ss.inv_e1(), ss.inv_e2());
                     let (a, b, fa) = (sp.delta_m, sp.support_m, sp.force_n.abs());
-                    let denom = a * p + b * q;
+                    let denom = a * pp + b * q;
                     let wc = sp.w_contact;
                     let c = self.c1 * wc * wc + self.c2 * (1.0 - wc) * (1.0 - wc);
                     let kd = if denom > 0.0 && fa > 0.0 {
                         let k = fa / denom;
-                        let dw = p * q * a * b * (p - q) * k / (fa * denom * denom);
+                        let dw = pp * q * a * b * (pp - q) * k / (fa * denom * denom);
                         let dc = 2.0 * (self.c1 * wc - self.c2 * (1.0 - wc)) * dw;
                         k + dc * f.delta_dot_m_s
                     } else {
@@ -663,104 +664,101 @@ impl OdeSystem<N> for DropSystem {
                 }
             };
             let (fnn, ft) = (f.normal_n, f.friction_n);
-            let dfn_dd = [kd * n[0] + c * pw[0] / dist, kd * n[1] + c * pw[1] / dist];
-            let dfn_dw = [c * n[0], c * n[1]];
+            // Gradients of F_n (eq. 7) over d = p_r - p_b and w = v_r - v_b.
+            let dfn_dd = kd * n + (c / dist) * pw;
+            let dfn_dw = c * n;
             // Friction: d F_t over d, w and the two spins.
-            let (mut dft_dd, mut dft_dw, mut dft_dwr, mut dft_dwb) = ([0.0; 2], [0.0; 2], 0.0, 0.0);
+            let (mut dft_dd, mut dft_dw, mut dft_dwr, mut dft_dwb) =
+                (Vector2::zeros(), Vector2::zeros(), 0.0, 0.0);
             match (self.law, self.mode.slip) {
                 (FrictionLaw::Regularised { v_eps_m_s }, _) => {
                     let th = (f.v_rel_m_s / v_eps_m_s).tanh();
                     let slope = self.mu_d * fnn * (1.0 - th * th) / v_eps_m_s;
-                    for k in 0..2 {
-                        // v_rel depends on d through the turning tangent: w . (R P / |d|).
-                        let dv_dd = (w[0] * rp[0][k] + w[1] * rp[1][k]) / dist;
-                        dft_dd[k] = self.mu_d * th * dfn_dd[k] + slope * dv_dd;
-                        dft_dw[k] = self.mu_d * th * dfn_dw[k] + slope * t[k];
-                    }
+                    // v_rel depends on d through the turning tangent: (R P)^T w / |d|.
+                    let dv_dd = rp.transpose() * w / dist;
+                    dft_dd = self.mu_d * th * dfn_dd + slope * dv_dd;
+                    dft_dw = self.mu_d * th * dfn_dw + slope * t;
                     dft_dwr = slope * self.r_r;
                     dft_dwb = -slope * self.r_b;
                 }
                 (FrictionLaw::Switched, Slip::Slipping(sign)) => {
-                    for k in 0..2 {
-                        dft_dd[k] = self.mu_d * sign * dfn_dd[k];
-                        dft_dw[k] = self.mu_d * sign * dfn_dw[k];
-                    }
+                    dft_dd = self.mu_d * sign * dfn_dd;
+                    dft_dw = self.mu_d * sign * dfn_dw;
                 }
                 (FrictionLaw::Switched, Slip::Sticking) => {}
             }
-            // Force on the race fc = F_n n + F_t t; the rotor gets -fc.
-            let mut dfc_dd = [[0.0; 2]; 2];
-            let mut dfc_dw = [[0.0; 2]; 2];
-            for i in 0..2 {
-                for k in 0..2 {
-                    dfc_dd[i][k] = n[i] * dfn_dd[k]
-                        + fnn * pm[i][k] / dist
-                        + t[i] * dft_dd[k]
-                        + ft * rp[i][k] / dist;
-                    dfc_dw[i][k] = n[i] * dfn_dw[k] + t[i] * dft_dw[k];
-                }
-            }
+            // Force on the race fc = F_n n + F_t t (the rotor gets -fc), over d and w.
+            let dfc_dd = n * dfn_dd.transpose()
+                + (fnn / dist) * p
+                + t * dft_dd.transpose()
+                + (ft / dist) * rp;
+            let dfc_dw = n * dfn_dw.transpose() + t * dft_dw.transpose();
+            let (ir, ib) = (1.0 / self.m_r, 1.0 / self.m_b);
+            let mut block = |row: usize, col: usize, m: Matrix2<f64>| {
+                let mut v = j.fixed_view_mut::<2, 2>(row, col);
+                v += m;
+            };
+            // Rotor rows: -fc / m_r, with d = p_r - p_b and w = v_r - v_b.
+            block(VR, QR, -dfc_dd * ir);
+            block(VR, VR, -dfc_dw * ir);
             let race = self.series.is_none();
-            for i in 0..2 {
-                for k in 0..2 {
-                    // Rotor rows 4,5: -fc/m_r; d = p_r - p_b.
-                    j[4 + i][k] -= dfc_dd[i][k] / self.m_r;
-                    j[4 + i][4 + k] -= dfc_dw[i][k] / self.m_r;
-                    if race {
-                        j[4 + i][2 + k] += dfc_dd[i][k] / self.m_r;
-                        j[4 + i][6 + k] += dfc_dw[i][k] / self.m_r;
-                        j[6 + i][k] += dfc_dd[i][k] / self.m_b;
-                        j[6 + i][2 + k] -= dfc_dd[i][k] / self.m_b;
-                        j[6 + i][4 + k] += dfc_dw[i][k] / self.m_b;
-                        j[6 + i][6 + k] -= dfc_dw[i][k] / self.m_b;
-                    }
-                }
-                j[4 + i][8] -= t[i] * dft_dwr / self.m_r;
-                j[4 + i][9] -= t[i] * dft_dwb / self.m_r;
-                if race {
-                    j[6 + i][8] += t[i] * dft_dwr / self.m_b;
-                    j[6 + i][9] += t[i] * dft_dwb / self.m_b;
-                }
+            if race {
+                block(VR, QB, dfc_dd * ir);
+                block(VR, VB, dfc_dw * ir);
+                block(VB, QR, dfc_dd * ib);
+                block(VB, QB, -dfc_dd * ib);
+                block(VB, VR, dfc_dw * ib);
+                block(VB, VB, -dfc_dw * ib);
+            }
+            let mut column = |row: usize, col: usize, v: Vector2<f64>| {
+                let mut c = j.fixed_view_mut::<2, 1>(row, col);
+                c += v;
+            };
+            column(VR, SR, -t * (dft_dwr * ir));
+            column(VR, SB, -t * (dft_dwb * ir));
+            if race {
+                column(VB, SR, t * (dft_dwr * ib));
+                column(VB, SB, t * (dft_dwb * ib));
             }
             // Spin rows: omega_r' = -F_t r_r / J_r, omega_b' = F_t R_b / J_b.
-            for (row, scale) in [(8, -self.r_r / self.j_r), (9, self.r_b / self.j_b)] {
-                for k in 0..2 {
-                    j[row][k] += scale * dft_dd[k];
-                    j[row][4 + k] += scale * dft_dw[k];
-                    if race {
-                        j[row][2 + k] -= scale * dft_dd[k];
-                        j[row][6 + k] -= scale * dft_dw[k];
-                    }
+            for (row, scale) in [(SR, -self.r_r / self.j_r), (SB, self.r_b / self.j_b)] {
+                let mut r = j.fixed_view_mut::<1, 2>(row, QR);
+                r += scale * dft_dd.transpose();
+                let mut r = j.fixed_view_mut::<1, 2>(row, VR);
+                r += scale * dft_dw.transpose();
+                if race {
+                    let mut r = j.fixed_view_mut::<1, 2>(row, QB);
+                    r -= scale * dft_dd.transpose();
+                    let mut r = j.fixed_view_mut::<1, 2>(row, VB);
+                    r -= scale * dft_dw.transpose();
                 }
-                j[row][8] += scale * dft_dwr;
-                j[row][9] += scale * dft_dwb;
+                j[(row, SR)] += scale * dft_dwr;
+                j[(row, SB)] += scale * dft_dwb;
             }
         }
         if self.series.is_none() && self.mode.support {
-            let (bx, by) = (y[XB], y[YB]);
-            let r = (bx * bx + by * by).sqrt();
+            let b = Vector2::new(y[XB], y[YB]);
+            let r = b.norm();
             if r > 0.0 {
-                let nb = [bx / r, by / r];
-                let vb = [y[VXB], y[VYB]];
-                let vn = vb[0] * nb[0] + vb[1] * nb[1];
-                let pv = [vb[0] - nb[0] * vn, vb[1] - nb[1] * vn];
-                let pm = [
-                    [1.0 - nb[0] * nb[0], -nb[0] * nb[1]],
-                    [-nb[1] * nb[0], 1.0 - nb[1] * nb[1]],
-                ];
+                let nb = b / r;
+                let vb = Vector2::new(y[VXB], y[VYB]);
+                let vn = vb.dot(&nb);
+                let pb = Matrix2::identity() - nb * nb.transpose();
+                let pv = pb * vb;
                 let kd = self.k2 * self.e2 * hertz::signed_pow(r, self.e2) / r;
                 let fs = f.support_n;
-                for i in 0..2 {
-                    for k in 0..2 {
-                        let dp = nb[i] * (kd * nb[k] + self.c2 * pv[k] / r) + fs * pm[i][k] / r;
-                        j[6 + i][2 + k] -= dp / self.m_b;
-                        j[6 + i][6 + k] -= self.c2 * nb[i] * nb[k] / self.m_b;
-                        // Tangential damper -c2_t (v - nb (nb.v)): its turning with nb.
-                        j[6 + i][2 + k] +=
-                            self.c2_t * (pm[i][k] * vn + nb[i] * pv[k]) / (r * self.m_b);
-                        j[6 + i][6 + k] -= self.c2_t * pm[i][k] / self.m_b;
-                    }
-                }
+                // The support's force -F_s nb (eq. 7, radial) and its radial damper, over the
+                // race position and velocity; then the tangential damper -c2_t (v - nb (nb.v))
+                // and its turning with nb.
+                let dp = nb * (kd * nb + (self.c2 / r) * pv).transpose() + (fs / r) * pb;
+                let ib = 1.0 / self.m_b;
+                let tangential_dq = self.c2_t * (pb * vn + nb * pv.transpose()) / (r * self.m_b);
+                let mut q = j.fixed_view_mut::<2, 2>(VB, QB);
+                q -= dp * ib;
+                q += tangential_dq;
+                let mut v = j.fixed_view_mut::<2, 2>(VB, VB);
+                v -= (self.c2 * ib) * nb * nb.transpose();
+                v -= (self.c2_t * ib) * pb;
             }
         }
         Some(sj)

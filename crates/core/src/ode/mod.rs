@@ -28,8 +28,11 @@ pub const MAX_GUARDS: usize = 4;
 /// Most state components an approximate (stiff) Jacobian may couple.
 pub const MAX_STIFF: usize = 10;
 
+/// The matrix of a [`StiffJacobian`] (nalgebra's fixed-size storage).
+pub type JacobianMatrix = nalgebra::SMatrix<f64, MAX_STIFF, MAX_STIFF>;
+
 /// An approximate Jacobian restricted to a few state components, for the linearly implicit
-/// stepper ([`Ros34pw2`]): `jac[a][b]` approximates `d f_{idx[a]} / d y_{idx[b]}`; every
+/// stepper ([`Ros34pw2`]): `jac[(a, b)]` approximates `d f_{idx[a]} / d y_{idx[b]}`; every
 /// entry outside these rows and columns is taken as zero.
 #[derive(Debug, Clone, Copy)]
 pub struct StiffJacobian {
@@ -38,9 +41,9 @@ pub struct StiffJacobian {
     /// How many components are coupled.
     pub len: usize,
     /// The restricted Jacobian (1/s units of the state's components).
-    pub jac: [[f64; MAX_STIFF]; MAX_STIFF],
+    pub jac: JacobianMatrix,
     /// How many leading components are *kinematic*: positions `q_a` (a < `kinematic`) whose
-    /// rows say exactly `q_a' = y_{idx[kinematic + a]}` (`jac[a][kinematic + a] = 1`, every
+    /// rows say exactly `q_a' = y_{idx[kinematic + a]}` (`jac[(a, kinematic + a)] = 1`, every
     /// other entry of the row zero). The stepper then eliminates them and factors only the
     /// remaining `len - kinematic` components (a Schur complement). 0 (the default of
     /// [`StiffJacobian::over`]): no such structure is claimed. At most `len / 2`.
@@ -53,7 +56,7 @@ impl StiffJacobian {
         let mut s = Self {
             idx: [0; MAX_STIFF],
             len: idx.len(),
-            jac: [[0.0; MAX_STIFF]; MAX_STIFF],
+            jac: JacobianMatrix::zeros(),
             kinematic: 0,
         };
         s.idx[..idx.len()].copy_from_slice(idx);

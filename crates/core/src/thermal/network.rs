@@ -268,6 +268,8 @@ impl Network {
     }
 }
 
+use nalgebra::{SMatrix, SVector};
+
 /// Size of the augmented system of [`ExactStep`]: seven temperatures, the ambient-loss
 /// accumulator, and seven constant heat inputs.
 const AUG: usize = 2 * NODES + 1;
@@ -281,123 +283,43 @@ const AUG: usize = 2 * NODES + 1;
 pub struct ExactStep {
     /// The step (s).
     pub h_s: f64,
-    phi: [[f64; NODES + 1]; NODES + 1],
-    gamma: [[f64; NODES]; NODES + 1],
+    phi: SMatrix<f64, { NODES + 1 }, { NODES + 1 }>,
+    gamma: SMatrix<f64, { NODES + 1 }, NODES>,
 }
 
 impl ExactStep {
-    /// Precomputes the step of `h_s` for `net`.
+    /// Precomputes the step of `h_s` for `net`: nalgebra's matrix exponential (scaling and
+    /// squaring with a Pade approximant) of the augmented matrix.
     pub fn new(net: &Network, h_s: f64) -> Self {
         let g = net.conductance_matrix();
-        let mut z = [[0.0; AUG]; AUG];
+        let mut z = SMatrix::<f64, AUG, AUG>::zeros();
         for a in 0..NODES {
             for b in 0..NODES {
-                z[a][b] = -g[a][b] / net.capacity_j_k[a] * h_s;
+                z[(a, b)] = -g[a][b] / net.capacity_j_k[a] * h_s;
             }
-            z[a][NODES + 1 + a] = h_s / net.capacity_j_k[a];
-            z[NODES][a] = net.ambient_w_k[a] * h_s;
+            z[(a, NODES + 1 + a)] = h_s / net.capacity_j_k[a];
+            z[(NODES, a)] = net.ambient_w_k[a] * h_s;
         }
-        let e = expm(&z);
-        let mut phi = [[0.0; NODES + 1]; NODES + 1];
-        let mut gamma = [[0.0; NODES]; NODES + 1];
-        for a in 0..=NODES {
-            phi[a].copy_from_slice(&e[a][..=NODES]);
-            gamma[a].copy_from_slice(&e[a][NODES + 1..]);
+        let e = z.exp();
+        Self {
+            h_s,
+            phi: e
+                .fixed_view::<{ NODES + 1 }, { NODES + 1 }>(0, 0)
+                .into_owned(),
+            gamma: e
+                .fixed_view::<{ NODES + 1 }, NODES>(0, NODES + 1)
+                .into_owned(),
         }
-        Self { h_s, phi, gamma }
     }
 
     /// Advances temperature rises `dt_k` and the ambient loss `lost_j` over the step with
     /// constant heat input `q_w`.
     pub fn advance(&self, dt_k: &mut [f64; NODES], lost_j: &mut f64, q_w: &[f64; NODES]) {
-        let mut x = [0.0; NODES + 1];
-        x[..NODES].copy_from_slice(dt_k);
+        let mut x = SVector::<f64, { NODES + 1 }>::zeros();
+        x.fixed_rows_mut::<NODES>(0).copy_from_slice(dt_k);
         x[NODES] = *lost_j;
-        let mut out = [0.0; NODES + 1];
-        for (a, o) in out.iter_mut().enumerate() {
-            let mut s = 0.0;
-            for b in 0..=NODES {
-                s += self.phi[a][b] * x[b];
-            }
-            for b in 0..NODES {
-                s += self.gamma[a][b] * q_w[b];
-            }
-            *o = s;
-        }
-        dt_k.copy_from_slice(&out[..NODES]);
+        let out = self.phi * x + self.gamma * SVector::<f64, NODES>::from_column_slice(q_w);
+        dt_k.copy_from_slice(&out.as_slice()[..NODES]);
         *lost_j = out[NODES];
-    }
-}
-
-/// Matrix exponential by scaling and squaring with a Taylor series: scaled to a 1-norm at
-/// most 1/2, 18 terms leave a truncation error below 1e-22 relative. Hand-written because it
-/// is needed once per run on a 15 x 15 matrix, which does not justify a linear-algebra crate.
-fn expm<const M: usize>(a: &[[f64; M]; M]) -> [[f64; M]; M] {
-    let norm = (0..M)
-        .map(|j| (0..M).map(|i| a[i][j].abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    let mut squarings = 0;
-    let mut scale = 1.0;
-    while norm * scale > 0.5 {
-        scale *= 0.5;
-        squarings += 1;
-    }
-    let mut x = *a;
-    for row in x.iter_mut() {
-        for v in row.iter_mut() {
-            *v *= scale;
-        }
-    }
-    let mut result = [[0.0; M]; M];
-    let mut term = [[0.0; M]; M];
-    for i in 0..M {
-        result[i][i] = 1.0;
-        term[i][i] = 1.0;
-    }
-    for k in 1..=18 {
-        term = matmul(&term, &x);
-        for row in term.iter_mut() {
-            for v in row.iter_mut() {
-                *v /= k as f64;
-            }
-        }
-        for i in 0..M {
-            for j in 0..M {
-                result[i][j] += term[i][j];
-            }
-        }
-    }
-    for _ in 0..squarings {
-        result = matmul(&result, &result);
-    }
-    result
-}
-
-fn matmul<const M: usize>(a: &[[f64; M]; M], b: &[[f64; M]; M]) -> [[f64; M]; M] {
-    let mut c = [[0.0; M]; M];
-    for i in 0..M {
-        for k in 0..M {
-            let aik = a[i][k];
-            if aik == 0.0 {
-                continue;
-            }
-            for j in 0..M {
-                c[i][j] += aik * b[k][j];
-            }
-        }
-    }
-    c
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn expm_of_a_rotation_generator_is_the_rotation() {
-        let a = [[0.0, -2.0], [2.0, 0.0]];
-        let e = expm(&a);
-        assert!((e[0][0] - 2f64.cos()).abs() < 1e-14);
-        assert!((e[1][0] - 2f64.sin()).abs() < 1e-14);
     }
 }
