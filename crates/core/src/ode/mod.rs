@@ -138,6 +138,12 @@ pub struct Stats {
     pub rejected: u64,
     /// Located events (mode switches).
     pub events: u64,
+    /// Stiff Jacobians evaluated (implicit stepper only).
+    #[serde(default)]
+    pub jacobians: u64,
+    /// LU factorisations of the Rosenbrock matrix (implicit stepper only; one per attempt).
+    #[serde(default)]
+    pub factorizations: u64,
 }
 
 /// An adaptive one-step method with dense output, as [`integrate`] drives it.

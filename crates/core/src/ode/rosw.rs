@@ -394,8 +394,10 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
         self.lu.j = sys
             .stiff_jacobian(t, y)
             .unwrap_or_else(|| StiffJacobian::over(&[]));
+        self.core.stats.jacobians += 1;
         let (lu, f0) = (&mut self.lu, &self.f0);
         let (y1, h) = self.core.control(&LAW, t, h_cap, |core, h| {
+            core.stats.factorizations += 1;
             if lu.factor(h * GAMMA) {
                 Self::attempt(core, lu, f0, sys, t, y, h)
             } else {
