@@ -18,7 +18,7 @@ struct Check {
 impl Observer<DropSystem, N> for Check {
     fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
         self.seen += 1;
-        if self.seen % self.every != 0 {
+        if !self.seen.is_multiple_of(self.every) {
             return ControlFlow::Continue(());
         }
         // The sticking constraint's dependence on the state is left out by design.

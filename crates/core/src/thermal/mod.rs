@@ -309,7 +309,7 @@ impl ThermalRun {
         }
         self.load_n = self.model.expansion.load_n(&self.dt_k);
         self.peak_load_n = self.peak_load_n.max(self.load_n);
-        if self.syncs % self.stride == 0 {
+        if self.syncs.is_multiple_of(self.stride) {
             self.record(t, (e_s + e_b) / h);
         }
         self.load_n
