@@ -1,0 +1,118 @@
+//! A results folder is a record: complete, or the tool says loudly that it is not. End-to-end
+//! tests of what must never exit 0 with wrong results, one test per failure: each runs the
+//! binary the way a user would and checks the exit code, the message and the files.
+
+mod common;
+use common::*;
+
+use serde_json::Value;
+use std::path::Path;
+
+fn sweep(spec: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["sweep", s(spec), "--out", s(out), "--no-progress"];
+    args.extend_from_slice(extra);
+    whirlmap(&args)
+}
+
+fn out_text(o: &std::process::Output) -> String {
+    out(o)
+}
+
+#[test]
+fn impossible_physics_is_refused_and_a_failed_energy_audit_fails_the_drop() {
+    let short = [
+        "--duration-s",
+        "0.02",
+        "--set",
+        "classification.max_extension_s=0",
+    ];
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "rotor_polar_moi_kg_m2=1e-300",
+            &["rotor_polar_moi_kg_m2 = 1e-300", "gyration"],
+        ),
+        (
+            "rotor_mass_kg=1e308",
+            &["rotor_mass_kg = 1e308", "[1e-3, 1e6] kg"],
+        ),
+        (
+            "pitch_diameter_m=1e-9",
+            &["pitch_diameter_m = 1e-9", "race bore diameter"],
+        ),
+        // Table 4's k2 in N/mm^1.5, read as N/m^1.5.
+        (
+            "support_stiffness_n_per_m_e=2.47e5",
+            &["support_stiffness_n_per_m_e", "N/mm^e"],
+        ),
+        // The exponent changed, the stiffness kept in the old unit.
+        (
+            "contact_exponent=2",
+            &["contact_stiffness_n_per_m_e", "1 um"],
+        ),
+    ];
+    for (set, needles) in cases {
+        let mut args = vec!["drop", "--set", set];
+        args.extend_from_slice(&short);
+        let o = whirlmap(&args);
+        assert_eq!(o.status.code(), Some(2), "{set}: {}", out_text(&o));
+        for n in *needles {
+            assert!(stderr(&o).contains(n), "{set}: `{n}` not in {}", stderr(&o));
+        }
+    }
+    // A valid scene whose books do not close (the race's absolute tolerance loosened 1e4-fold
+    // with the explicit stepper, no spin: the friction heat comes out negative): a typed
+    // failure, exit 3.
+    let bad = [
+        "--set",
+        "solver.rtol=1e-3",
+        "--set",
+        "solver.race_atol_scale=1e4",
+        "--set",
+        "classification.max_extension_s=0",
+    ];
+    let mut args = vec!["drop", "--speed-rpm", "0", "--duration-s", "0.2"];
+    args.extend_from_slice(&bad);
+    let o = whirlmap(&args);
+    assert_eq!(o.status.code(), Some(3), "{}", out_text(&o));
+    assert!(
+        stderr(&o).contains("energy_audit") && stderr(&o).contains("above the threshold"),
+        "{}",
+        stderr(&o)
+    );
+    // The same drop with tight tolerances passes, so the audit tells the two apart.
+    let o = whirlmap(&[
+        "drop",
+        "--speed-rpm",
+        "0",
+        "--duration-s",
+        "0.2",
+        "--set",
+        "classification.max_extension_s=0",
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["energy"]["residual_rel"].as_f64().unwrap() < 1e-4, "{v}");
+    // In a sweep, a failed point recorded with its kind; the sweep goes on (exit 1).
+    let dir = temp_dir("audit");
+    let spec = spec_file(
+        &dir,
+        "audit",
+        r#"{"name": "audit", "duration_s": 0.2,
+            "scene": {"speed_rpm": 0, "classification": {"max_extension_s": 0},
+                      "solver": {"rtol": 1e-3}},
+            "axes": {"solver.race_atol_scale": [1, 10000]}}"#,
+    );
+    let out_dir = dir.join("out");
+    let o = sweep(&spec, &out_dir, &[]);
+    assert_eq!(o.status.code(), Some(1), "{}", out_text(&o));
+    let recs: Vec<Value> = std::fs::read_to_string(out_dir.join("points.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(recs[0]["status"], "ok", "{}", recs[0]);
+    assert_eq!(recs[1]["status"], "failed");
+    assert_eq!(recs[1]["error"]["kind"], "energy_audit", "{}", recs[1]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
