@@ -54,11 +54,11 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// Runs the benchmark cases and prints a table.
 pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
     let reps = a.reps.max(1);
-    println!(
+    outln!(
         "whirlmap bench (one thread, default tolerance rtol = {:e})",
         Scene::paper().solver.rtol
     );
-    println!(
+    outln!(
         "{:<36} {:>10} {:>11} {:>9} {:>8} {:>7} {:>12} {:>16}",
         "case",
         "wall ms",
@@ -189,9 +189,10 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         let (r, evals) = last.expect("reps >= 1");
         print_row(name, median(walls), &r, evals);
         if let Some(th) = &r.thermal {
-            println!(
+            outln!(
                 "    {} network steps for {:.3} s simulated",
-                th.network_steps, r.end_time_s
+                th.network_steps,
+                r.end_time_s
             );
         }
     }
@@ -224,7 +225,7 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             black_box(&dy);
         }
         let ns = t.elapsed().as_secs_f64() * 1e9 / n as f64;
-        println!("one RHS evaluation (contact, {label}, drag on): {ns:.1} ns");
+        outln!("one RHS evaluation (contact, {label}, drag on): {ns:.1} ns");
     }
     Ok(())
 }
@@ -238,7 +239,7 @@ fn print_row(name: &str, wall_ms: f64, r: &DropReport, evals: ModelEvals) {
     } else {
         ""
     };
-    println!(
+    outln!(
         "{:<36} {:>10.2} {:>11} {:>9} {:>8} {:>7} {:>12.0} {:>16}{note}",
         name,
         wall_ms,
@@ -279,7 +280,7 @@ fn long_thermal_run(name: &str, scene: &Scene, duration_s: f64) -> anyhow::Resul
     print_row(name, wall * 1e3, &r, count.0);
     let th = r.thermal.as_ref().expect("a thermal scene");
     let per_60 = |x: f64| x * 60.0 / r.end_time_s;
-    println!(
+    outln!(
         "    {:.2} s simulated ({:?}): {:.0} dynamic RHS evaluations and {:.0} network steps per simulated second; \
          CPU {} ({} per 60 s simulated)",
         r.end_time_s,
@@ -312,7 +313,7 @@ fn print_thermal_differences(full: &DropReport, draft: &DropReport) {
         })
         .fold(0.0, f64::max);
     let (ha, hb) = (a.heat, b.heat);
-    println!(
+    outln!(
         "    draft vs full: largest node temperature difference (final or peak) {:.4} K = {:.1e} of the {:.2} K rise; \
          peak F_th {:.3} vs {:.3} N",
         d_t,
@@ -321,7 +322,7 @@ fn print_thermal_differences(full: &DropReport, draft: &DropReport) {
         b.peak_thermal_load_n,
         a.peak_thermal_load_n
     );
-    println!(
+    outln!(
         "    heat H_s {:.3} vs {:.3} J, H_i {:.3} vs {:.3} J, H_o {:.3} vs {:.3} J; end {:.3} vs {:.3} s, \
          rotor {:.1} vs {:.1} r/min, race {:.1} vs {:.1} r/min",
         hb.h_s_j,

@@ -3,7 +3,6 @@
 //! them; 2 error (a folder without points.jsonl, a bad option, an unwritable report).
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 use whirlmap_sweep::compare::{compare, write_report, Thresholds};
 
 /// Arguments of `whirlmap compare`.
@@ -26,31 +25,31 @@ pub struct CompareArgs {
 }
 
 /// Runs the subcommand and returns the process exit code.
-pub fn run(a: &CompareArgs) -> ExitCode {
+pub fn run(a: &CompareArgs) -> u8 {
     let t = Thresholds {
         force_rel: a.force_rel,
         power_rel: a.power_rel,
     };
     if let Err(e) = t.validate() {
-        eprintln!("error: {e}");
-        return ExitCode::from(2);
+        errln!("error: {e}");
+        return 2;
     }
     let c = match compare(&a.baseline, &a.new, t) {
         Ok(c) => c,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            errln!("error: {e}");
+            return 2;
         }
     };
     let out = a.out.clone().unwrap_or_else(|| a.new.join("compare.md"));
     let png = match write_report(&c, &out) {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            errln!("error: {e}");
+            return 2;
         }
     };
-    println!(
+    outln!(
         "compare: {}: {} of {} points and {} of {} critical speeds changed",
         if c.changed() { "CHANGED" } else { "same" },
         c.points.len(),
@@ -59,16 +58,16 @@ pub fn run(a: &CompareArgs) -> ExitCode {
         c.critical_compared
     );
     for p in &c.points {
-        println!("  point {}: {}", p.inputs, p.what.join("; "));
+        outln!("  point {}: {}", p.inputs, p.what.join("; "));
     }
     for k in &c.critical {
-        println!("  critical speed at mu = {}: {}", k.mu, k.what);
+        outln!("  critical speed at mu = {}: {}", k.mu, k.what);
     }
-    println!("  report           {}", out.display());
-    println!("  class map        {}", png.display());
+    outln!("  report           {}", out.display());
+    outln!("  class map        {}", png.display());
     if c.changed() {
-        ExitCode::from(1)
+        1
     } else {
-        ExitCode::SUCCESS
+        0
     }
 }

@@ -7,7 +7,6 @@
 //! could not be written.
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 use whirlmap_sweep::merge::merge;
 
 /// Arguments of `whirlmap merge`.
@@ -22,39 +21,43 @@ pub struct MergeArgs {
 }
 
 /// Runs the subcommand and returns the process exit code.
-pub fn run(a: &MergeArgs) -> ExitCode {
+pub fn run(a: &MergeArgs) -> u8 {
     let out = match &a.out {
         Some(o) => o.clone(),
         None => match whirlmap_sweep::shard::read_shard_manifest(&a.dirs[0]) {
             Ok(m) => PathBuf::from("results").join(&m.spec.name),
             Err(e) => {
-                eprintln!("error: merge refused:\n  - {e}");
-                return ExitCode::from(2);
+                errln!("error: merge refused:\n  - {e}");
+                return 2;
             }
         },
     };
     match merge(&a.dirs, &out) {
         Ok(o) => {
-            println!(
+            outln!(
                 "merge {}: {} shards, {} points, {} ok, {} failed",
-                o.name, o.shards, o.points, o.ok, o.failed
+                o.name,
+                o.shards,
+                o.points,
+                o.ok,
+                o.failed
             );
             for (class, n) in &o.classes {
-                println!("  {class:<16} {n}");
+                outln!("  {class:<16} {n}");
             }
-            println!("  output           {}", out.display());
+            outln!("  output           {}", out.display());
             if !o.charts.is_empty() {
-                println!("  charts           {} files", o.charts.len());
+                outln!("  charts           {} files", o.charts.len());
             }
             if o.failed > 0 {
-                ExitCode::from(1)
+                1
             } else {
-                ExitCode::SUCCESS
+                0
             }
         }
         Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(e.exit_code())
+            errln!("error: {e}");
+            e.exit_code()
         }
     }
 }

@@ -30,7 +30,7 @@ pub fn run(a: &RenderArgs) -> Result<(), RenderFailure> {
         }
     })?;
     for p in &written {
-        println!("{}", p.display());
+        outln!("{}", p.display());
     }
     Ok(())
 }

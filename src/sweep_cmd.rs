@@ -5,7 +5,6 @@
 //! written.
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 use whirlmap_sweep::spec;
 use whirlmap_sweep::sweep::{run_sweep, ProgressMode, RunOptions, SweepError};
 
@@ -37,12 +36,12 @@ pub struct SweepArgs {
 }
 
 /// Runs the subcommand and returns the process exit code.
-pub fn run(a: &SweepArgs) -> ExitCode {
+pub fn run(a: &SweepArgs) -> u8 {
     let spec = match spec::load(&a.file) {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            errln!("error: {e}");
+            return 2;
         }
     };
     if let (Some(i), Some(n)) = (a.shard, a.shards) {
@@ -65,14 +64,14 @@ pub fn run(a: &SweepArgs) -> ExitCode {
     let outcome = match run_sweep(&spec, &opts) {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(match e {
+            errln!("error: {e}");
+            return match e {
                 SweepError::Spec(_) | SweepError::ThreadPool(_) => 2,
                 SweepError::Io { .. } => 4,
-            });
+            };
         }
     };
-    println!(
+    outln!(
         "sweep {}: {} points, {} ok, {} failed{}",
         spec.name,
         outcome.points,
@@ -85,39 +84,39 @@ pub fn run(a: &SweepArgs) -> ExitCode {
         }
     );
     for (class, n) in &outcome.classes {
-        println!("  {class:<16} {n}");
+        outln!("  {class:<16} {n}");
     }
-    println!("  output           {}", outcome.out_dir.display());
+    outln!("  output           {}", outcome.out_dir.display());
     let progress = !a.no_progress;
     match whirlmap_sweep::extras::run_all(&spec, &outcome.out_dir, opts.threads, progress) {
         Ok(x) => {
             if let Some(p) = x.critical {
-                println!("  critical speeds  {}", p.display());
+                outln!("  critical speeds  {}", p.display());
             }
             if !x.orbits.is_empty() {
-                println!("  orbits           {} drops recorded", x.orbits.len());
+                outln!("  orbits           {} drops recorded", x.orbits.len());
             }
             if let Some(p) = x.probability {
-                println!("  probability      {}", p.display());
+                outln!("  probability      {}", p.display());
             }
         }
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(4);
+            errln!("error: {e}");
+            return 4;
         }
     }
     if !spec.charts.is_empty() {
         match whirlmap_sweep::charts::render_all(&outcome.out_dir) {
-            Ok(written) => println!("  charts           {} files", written.len()),
+            Ok(written) => outln!("  charts           {} files", written.len()),
             Err(e) => {
-                eprintln!("error: charts: {e}");
-                return ExitCode::from(4);
+                errln!("error: charts: {e}");
+                return 4;
             }
         }
     }
     if outcome.failed > 0 {
-        ExitCode::from(1)
+        1
     } else {
-        ExitCode::SUCCESS
+        0
     }
 }

@@ -7,6 +7,17 @@ use common::*;
 
 use serde_json::Value;
 use std::path::Path;
+use std::process::{Command, Stdio};
+
+/// A grid of four short drops (the classifier's extension off, so each is 0.05 s).
+const TINY: &str = r#"{"name": "tiny", "scene": {"classification": {"max_extension_s": 0}},
+  "duration_s": 0.05, "axes": {"speed_rpm": [4000, 8000], "mu": [0.1, 0.3]}}"#;
+
+/// [`TINY`] drawing `charts` (a JSON list).
+fn tiny_with_charts(charts: &str) -> String {
+    let body = TINY.trim_end().strip_suffix('}').unwrap();
+    format!("{body}, \"charts\": {charts}}}")
+}
 
 fn sweep(spec: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
     let mut args = vec!["sweep", s(spec), "--out", s(out), "--no-progress"];
@@ -16,6 +27,19 @@ fn sweep(spec: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
 
 fn out_text(o: &std::process::Output) -> String {
     out(o)
+}
+
+/// Runs `whirlmap` with standard output a pipe nobody reads (closed before it starts).
+fn closed_stdout(args: &[&str]) -> std::process::Output {
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let child = Command::new(BIN)
+        .args(args)
+        .stdout(writer)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.wait_with_output().unwrap()
 }
 
 #[test]
@@ -114,5 +138,36 @@ fn impossible_physics_is_refused_and_a_failed_energy_audit_fails_the_drop() {
     assert_eq!(recs[0]["status"], "ok", "{}", recs[0]);
     assert_eq!(recs[1]["status"], "failed");
     assert_eq!(recs[1]["error"]["kind"], "energy_audit", "{}", recs[1]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_closed_stdout_ends_quietly_and_the_work_is_finished() {
+    let o = closed_stdout(&["scene"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+    let o = closed_stdout(&[
+        "drop",
+        "--duration-s",
+        "0.02",
+        "--set",
+        "classification.max_extension_s=0",
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let dir = temp_dir("closed-stdout");
+    let spec = spec_file(
+        &dir,
+        "tiny",
+        &tiny_with_charts(r#"["classes", "max_force"]"#),
+    );
+    let out_dir = dir.join("out");
+    let o = closed_stdout(&["sweep", s(&spec), "--out", s(&out_dir), "--no-progress"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).is_empty(), "{}", stderr(&o));
+    assert!(
+        out_dir.join("charts/classes.png").is_file(),
+        "the charts were skipped"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

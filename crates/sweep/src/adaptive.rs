@@ -536,11 +536,11 @@ pub fn run_adaptive(
         let v = pool.install(|| evaluate_points(spec, &batch));
         done += pts.len();
         if show_progress {
-            eprintln!(
+            crate::sweep::progress_line(&format!(
                 "adaptive {}: {done} corners evaluated, {:.0} s",
                 spec.name,
                 start.elapsed().as_secs_f64()
-            );
+            ));
         }
         v
     };

@@ -979,11 +979,11 @@ pub fn run_ensemble(
     let mut progress = |done: usize, total: usize| {
         if show_progress && (last.elapsed() >= Duration::from_secs(5) || done == total) {
             last = Instant::now();
-            eprintln!(
+            crate::sweep::progress_line(&format!(
                 "ensemble {}: {done}/{total} drops, {:.0} s",
                 spec.name,
                 start.elapsed().as_secs_f64()
-            );
+            ));
         }
     };
     let members = pool.install(|| run_members(params, &cells, spec.duration_s, &mut progress));

@@ -296,6 +296,12 @@ struct Progress {
 
 const PLAIN_EVERY: Duration = Duration::from_secs(5);
 
+/// Writes a progress line to standard error; a closed standard error is ignored (progress is
+/// not the result, and `eprintln!` would panic).
+pub fn progress_line(line: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
+}
+
 impl Progress {
     fn new(name: &str, total: usize, already: usize, mode: ProgressMode) -> Self {
         let on = mode == ProgressMode::Auto;
@@ -346,7 +352,7 @@ impl Progress {
             let mut last = self.last_line.lock().unwrap_or_else(|e| e.into_inner());
             if last.elapsed() >= PLAIN_EVERY {
                 *last = Instant::now();
-                eprintln!("{}", self.line());
+                progress_line(&self.line());
             }
         }
     }
@@ -372,7 +378,7 @@ impl Progress {
             b.finish_and_clear();
         }
         if self.plain && self.start.elapsed() >= PLAIN_EVERY {
-            eprintln!("{}", self.line());
+            progress_line(&self.line());
         }
     }
 }
