@@ -179,7 +179,7 @@ fn build_scene_with(
         Some(p) => {
             let text = std::fs::read_to_string(p)
                 .with_context(|| format!("cannot read scene file {}", p.display()))?;
-            serde_json::from_str::<Scene>(&text)
+            whirlmap_core::json::from_str::<Scene>(&text)
                 .with_context(|| format!("scene file {}", p.display()))?
         }
         None => Scene::paper(),

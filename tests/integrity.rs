@@ -171,3 +171,44 @@ fn a_closed_stdout_ends_quietly_and_the_work_is_finished() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_list_where_an_object_belongs_is_refused() {
+    let dir = temp_dir("lists");
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, "[1000, 0.1]").unwrap();
+    let o = whirlmap(&["drop", "--scene", s(&scene), "--duration-s", "0.02"]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(
+        stderr(&o).contains("top level") && stderr(&o).contains("not a list"),
+        "{}",
+        stderr(&o)
+    );
+    for (set, needle) in [
+        ("thermal=[0.5]", "`thermal` must be a JSON object"),
+        ("solver=[1e-6]", "`solver` must be a JSON object"),
+        // serde refuses this one itself.
+        (r#"friction_law={"regularised": [0.01]}"#, "friction_law"),
+    ] {
+        let o = whirlmap(&["drop", "--set", set, "--duration-s", "0.02"]);
+        assert_eq!(o.status.code(), Some(2), "{set}: {}", out_text(&o));
+        assert!(stderr(&o).contains(needle), "{set}: {}", stderr(&o));
+    }
+    let base = r#""name": "l", "duration_s": 0.05, "axes": {"mu": [0.1]}"#;
+    for (body, place) in [
+        (r#""scene": [1000, 0.1]"#, "`scene`"),
+        (
+            r#""critical": {"mu": [0.3], "speed_rpm": [2000, 4000]}"#,
+            "`critical.speed_rpm`",
+        ),
+        (r#""orbits": [8000, [0.1]]"#, "`orbits`"),
+    ] {
+        let spec = spec_file(&dir, "l", &format!("{{{base}, {body}}}"));
+        let out_dir = dir.join("out");
+        let o = sweep(&spec, &out_dir, &[]);
+        assert_eq!(o.status.code(), Some(2), "{body}: {}", out_text(&o));
+        assert!(stderr(&o).contains(place), "{body}: {}", stderr(&o));
+        assert!(!out_dir.join("points.jsonl").exists());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -479,10 +479,11 @@ pub fn load(path: impl AsRef<Path>) -> Result<EnsembleSpec, SpecError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let spec: EnsembleSpec = serde_json::from_str(&text).map_err(|source| SpecError::Parse {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let spec: EnsembleSpec =
+        whirlmap_core::json::from_str(&text).map_err(|source| SpecError::Parse {
+            path: path.to_path_buf(),
+            source,
+        })?;
     spec.cells()?;
     Ok(spec)
 }

@@ -89,10 +89,19 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
         };
         node = next;
     }
-    *scene = serde_json::from_value(root).map_err(|e| OverrideError::BadValue {
-        key: key.to_string(),
-        reason: e.to_string(),
+    let parsed: Scene =
+        serde_json::from_value(root.clone()).map_err(|e| OverrideError::BadValue {
+            key: key.to_string(),
+            reason: e.to_string(),
+        })?;
+    // A list where the scene has an object would be read by position.
+    whirlmap_core::json::check_objects(&root, &parsed).map_err(|reason| {
+        OverrideError::BadValue {
+            key: key.to_string(),
+            reason,
+        }
     })?;
+    *scene = parsed;
     Ok(())
 }
 

@@ -505,9 +505,10 @@ pub fn load(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
     Ok(spec)
 }
 
-/// Parses spec text (no validation beyond types and unknown keys).
+/// Parses spec text (no validation beyond types, unknown keys, and lists where an object
+/// belongs: [`whirlmap_core::json::from_str`]).
 pub fn parse(text: &str) -> Result<SweepSpec, serde_json::Error> {
-    serde_json::from_str(text)
+    whirlmap_core::json::from_str(text)
 }
 
 impl SweepSpec {
