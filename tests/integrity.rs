@@ -8,6 +8,7 @@ use common::*;
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
 
 /// A grid of four short drops (the classifier's extension off, so each is 0.05 s).
 const TINY: &str = r#"{"name": "tiny", "scene": {"classification": {"max_extension_s": 0}},
@@ -40,6 +41,112 @@ fn closed_stdout(args: &[&str]) -> std::process::Output {
         .spawn()
         .unwrap();
     child.wait_with_output().unwrap()
+}
+
+#[test]
+fn huge_grids_are_refused_at_once() {
+    let dir = temp_dir("huge");
+    let cases = [
+        (
+            r#"{"from": 0, "to": 1, "steps": 18446744073709551615}"#,
+            "18446744073709551615",
+        ),
+        (
+            r#"{"from": 0, "to": 1, "steps": 10000000000}"#,
+            "10000000000",
+        ),
+        (r#"{"from": 0, "to": 1, "steps": 1000000000}"#, "1000000000"),
+    ];
+    for (i, (axis, count)) in cases.iter().enumerate() {
+        let spec = spec_file(
+            &dir,
+            &format!("h{i}"),
+            &format!(r#"{{"name": "h", "duration_s": 0.05, "axes": {{"unbalance_m": {axis}}}}}"#),
+        );
+        let out_dir = dir.join(format!("out{i}"));
+        let start = Instant::now();
+        let o = whirlmap_within(
+            &["sweep", s(&spec), "--out", s(&out_dir), "--no-progress"],
+            Duration::from_secs(20),
+        )
+        .unwrap_or_else(|| panic!("{axis}: still validating after 20 s"));
+        assert_eq!(o.status.code(), Some(2), "{axis}: {}", out_text(&o));
+        let err = stderr(&o);
+        assert!(
+            err.contains(count) && err.contains("at most 10000000 points"),
+            "{axis}: {err}"
+        );
+        assert!(start.elapsed() < Duration::from_secs(5), "{axis}: slow");
+        assert!(!out_dir.join("points.jsonl").exists());
+    }
+    // Two axes whose product overflows 64 bits.
+    let spec = spec_file(
+        &dir,
+        "h-two",
+        r#"{"name": "h", "duration_s": 0.05, "axes": {
+            "speed_rpm": {"from": 0, "to": 1000, "steps": 18446744073709551615},
+            "mu": {"from": 0, "to": 1, "steps": 4}}}"#,
+    );
+    let o = whirlmap_within(
+        &["sweep", s(&spec), "--no-progress"],
+        Duration::from_secs(20),
+    )
+    .expect("answers at once");
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(
+        stderr(&o).contains("18446744073709551615 x 4"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn duplicate_grid_values_are_refused() {
+    let dir = temp_dir("dups");
+    let base = r#""name": "d", "duration_s": 0.05"#;
+    let cases = [
+        (
+            r#""axes": {"mu": [0.1, 0.1, 0.2]}"#,
+            "axes.mu: the value 0.1",
+        ),
+        (
+            r#""axes": {"mu": {"from": 0.2, "to": 0.2, "steps": 3}}"#,
+            "axes.mu: the value 0.2",
+        ),
+        (
+            r#""axes": {"unbalance_m": [0.0, -0.0]}"#,
+            "axes.unbalance_m: the value 0",
+        ),
+        (
+            r#""axes": {"speed_rpm": {"from": 1000, "to": 1000.0000000001, "steps": 3}}"#,
+            "axes.speed_rpm: the value 1000",
+        ),
+        (
+            r#""axes": {"mu": [0.1]}, "critical": {"mu": [0.3, 0.3], "speed_rpm": {"from": 2000, "to": 4000}}"#,
+            "critical.mu",
+        ),
+        (
+            r#""axes": {"mu": [0.1]}, "orbits": {"speed_rpm": 8000, "mu": [0.1, 0.2, 0.1]}"#,
+            "orbits.mu: the value 0.1",
+        ),
+    ];
+    for (i, (body, needle)) in cases.iter().enumerate() {
+        let spec = spec_file(&dir, &format!("d{i}"), &format!("{{{base}, {body}}}"));
+        let out_dir = dir.join(format!("out{i}"));
+        let o = sweep(&spec, &out_dir, &[]);
+        assert_eq!(o.status.code(), Some(2), "{body}: {}", out_text(&o));
+        assert!(
+            stderr(&o).contains(needle),
+            "{body}: `{needle}` not in {}",
+            stderr(&o)
+        );
+        assert!(
+            !out_dir.join("points.jsonl").exists(),
+            "{body}: points were run"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -138,6 +245,72 @@ fn impossible_physics_is_refused_and_a_failed_energy_audit_fails_the_drop() {
     assert_eq!(recs[0]["status"], "ok", "{}", recs[0]);
     assert_eq!(recs[1]["status"], "failed");
     assert_eq!(recs[1]["error"]["kind"], "energy_audit", "{}", recs[1]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn critical_ranges_are_checked_before_any_drop_and_named_readably() {
+    let dir = temp_dir("critical-ranges");
+    let cases = [
+        (
+            r#"{"from": 2000, "to": 1e308}"#,
+            "",
+            "critical.speed_rpm.to = 1e308",
+        ),
+        (
+            r#"{"from": -5, "to": 4000}"#,
+            "",
+            "critical.speed_rpm.from = -5",
+        ),
+        (
+            r#"{"from": 2000, "to": 4000}"#,
+            r#", "tol_rpm": 1e-300"#,
+            "critical.tol_rpm = 1e-300",
+        ),
+        (
+            r#"{"from": 2000, "to": 4000}"#,
+            r#", "resolution_rpm": 1e300"#,
+            "critical.resolution_rpm = 1e300",
+        ),
+    ];
+    for (i, (range, extra, needle)) in cases.iter().enumerate() {
+        let spec = spec_file(
+            &dir,
+            &format!("c{i}"),
+            &format!(
+                r#"{{"name": "c", "duration_s": 0.05, "axes": {{"mu": [0.1]}},
+                    "critical": {{"mu": [0.3], "speed_rpm": {range}{extra}}}}}"#
+            ),
+        );
+        let out_dir = dir.join(format!("out{i}"));
+        let o = sweep(&spec, &out_dir, &[]);
+        assert_eq!(o.status.code(), Some(2), "{needle}: {}", out_text(&o));
+        let err = stderr(&o);
+        assert!(err.contains(needle), "`{needle}` not in {err}");
+        assert!(err.len() < 400, "a number printed in full: {err}");
+        assert!(!out_dir.join("points.jsonl").exists());
+    }
+    // A friction range of 2^64 - 1 values: refused, not a crash.
+    let spec = spec_file(
+        &dir,
+        "cmu",
+        r#"{"name": "c", "duration_s": 0.05, "axes": {"mu": [0.1]},
+            "critical": {"mu": {"from": 0, "to": 1, "steps": 18446744073709551615},
+                         "speed_rpm": {"from": 2000, "to": 4000}}}"#,
+    );
+    let o = whirlmap_within(
+        &["sweep", s(&spec), "--no-progress"],
+        Duration::from_secs(20),
+    )
+    .expect("answers at once");
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(stderr(&o).contains("critical.mu"), "{}", stderr(&o));
+    // The command line says the same.
+    let o = whirlmap(&["critical", "--mu", "0.3", "--to", "1e308"]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(stderr(&o).contains("--to = 1e308"), "{}", stderr(&o));
+    let o = whirlmap(&["critical", "--mu", "0.3,0.3"]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

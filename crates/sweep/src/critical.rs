@@ -29,6 +29,7 @@ use crate::classify::OrbitClass;
 use crate::recheck::Recheck;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use whirlmap_core::scene::num;
 use whirlmap_core::{simulate, DropOptions, InvalidParameter, Scene, MODEL_VERSION};
 
 /// Default lattice step of the scan (r/min).
@@ -173,28 +174,28 @@ pub fn check_range(
     if !(from_rpm.is_finite() && (0.0..MAX_SPEED_RPM).contains(&from_rpm)) {
         return Err(InvalidParameter::new(
             "from_rpm",
-            from_rpm,
+            num(from_rpm),
             "[0, 1e6) r/min",
         ));
     }
     if !(to_rpm.is_finite() && to_rpm > from_rpm && to_rpm <= MAX_SPEED_RPM) {
         return Err(InvalidParameter::new(
             "to_rpm",
-            to_rpm,
-            &format!("({from_rpm}, 1e6] r/min (above from_rpm)"),
+            num(to_rpm),
+            &format!("({}, 1e6] r/min (above from_rpm)", num(from_rpm)),
         ));
     }
     if !(resolution_rpm.is_finite() && (1.0..=1e5).contains(&resolution_rpm)) {
         return Err(InvalidParameter::new(
             "resolution_rpm",
-            resolution_rpm,
+            num(resolution_rpm),
             "[1, 1e5] r/min",
         ));
     }
     if !((to_rpm - from_rpm) / resolution_rpm <= MAX_SCAN_POINTS) {
         return Err(InvalidParameter::new(
             "resolution_rpm",
-            resolution_rpm,
+            num(resolution_rpm),
             &format!(
                 ">= {} r/min for this range (at most 10000 scan points)",
                 (to_rpm - from_rpm) / MAX_SCAN_POINTS
@@ -204,8 +205,11 @@ pub fn check_range(
     if !(tol_rpm.is_finite() && tol_rpm >= 0.01 && tol_rpm <= resolution_rpm) {
         return Err(InvalidParameter::new(
             "tol_rpm",
-            tol_rpm,
-            &format!("[0.01, {resolution_rpm}] r/min (at most the resolution)"),
+            num(tol_rpm),
+            &format!(
+                "[0.01, {}] r/min (at most the resolution)",
+                num(resolution_rpm)
+            ),
         ));
     }
     Ok(())
@@ -218,10 +222,10 @@ pub fn check_mus(mus: &[f64]) -> Result<(), InvalidParameter> {
     }
     for (i, &mu) in mus.iter().enumerate() {
         if !(mu.is_finite() && (0.0..=2.0).contains(&mu)) {
-            return Err(InvalidParameter::new("mu", mu, "[0, 2]"));
+            return Err(InvalidParameter::new("mu", num(mu), "[0, 2]"));
         }
         if mus[..i].contains(&mu) {
-            return Err(InvalidParameter::new("mu", mu, "each value once"));
+            return Err(InvalidParameter::new("mu", num(mu), "each value once"));
         }
     }
     Ok(())

@@ -170,16 +170,18 @@ pub fn orbit_panels(spec: &SweepSpec) -> Option<(f64, Vec<f64>)> {
     if !spec.charts.iter().any(|c| c == "orbits") {
         return None;
     }
-    let points = spec.points().ok()?;
+    // The `mu` axis's values in axis order: the order in which the grid first meets them.
+    let axis = spec.axes.0.iter().find(|a| a.name == "mu")?;
     let mut mus: Vec<f64> = Vec::new();
-    for p in &points {
-        for (name, v) in &p.inputs {
-            if name == "mu" && !mus.contains(v) {
-                mus.push(*v);
-            }
+    for i in 0..axis.values.count() {
+        let v = axis.values.value(i);
+        if !mus.contains(&v) {
+            mus.push(v);
+        }
+        if mus.len() == 8 {
+            break;
         }
     }
-    mus.truncate(8);
     (!mus.is_empty()).then_some((8000.0, mus))
 }
 
