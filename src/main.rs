@@ -31,7 +31,7 @@ mod sweep_cmd;
 #[derive(Parser)]
 #[command(
     name = "whirlmap",
-    version,
+    version = whirlmap_sweep::build_info::DESCRIPTION,
     about = "Rotor drops onto AMB touchdown bearings: orbits, whirl, design charts"
 )]
 struct Cli {
@@ -58,7 +58,7 @@ enum Command {
     /// settings against a DOP853 reference (CSV, Markdown, log-log charts).
     Accuracy(accuracy_cmd::AccuracyArgs),
     /// Join the shard folders of a sweep into one result (exit 2 if a point is missing or
-    /// twice, or the shards differ in spec or model version; 1 if any point failed).
+    /// twice, or the shards differ in spec, model version or build; 1 if any point failed).
     Merge(merge_cmd::MergeArgs),
     /// Compare two sweep results: class changes, force and power changes beyond thresholds,
     /// critical-speed shifts; a Markdown report with a class map (exit 0 same, 1 changed,

@@ -2,9 +2,9 @@
 //! `whirlmap_sweep::merge`).
 //!
 //! Exit codes: 0 merged, every point ok; 1 merged, some point failed (recorded as data); 2
-//! refused (a point missing or present twice, shards of different specs, shard counts or
-//! model versions, a folder that is not a shard's) with every problem listed; 4 an output
-//! could not be written.
+//! refused (a point missing or present twice, shards of different specs, shard counts,
+//! model versions or builds, a folder that is not a shard's) with every problem listed; 4 an
+//! output could not be written.
 
 use std::path::PathBuf;
 use whirlmap_sweep::merge::merge;

@@ -6,7 +6,7 @@ mod common;
 use common::*;
 
 use serde_json::Value;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -41,6 +41,17 @@ fn closed_stdout(args: &[&str]) -> std::process::Output {
         .spawn()
         .unwrap();
     child.wait_with_output().unwrap()
+}
+
+/// The commit `whirlmap --version` names.
+fn built_commit() -> String {
+    let o = whirlmap(&["--version"]);
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    text.split("commit ")
+        .nth(1)
+        .and_then(|t| t.split(')').next())
+        .unwrap_or_else(|| panic!("no commit in --version: {text}"))
+        .to_string()
 }
 
 #[test]
@@ -383,5 +394,100 @@ fn a_list_where_an_object_belongs_is_refused() {
         assert!(stderr(&o).contains(place), "{body}: {}", stderr(&o));
         assert!(!out_dir.join("points.jsonl").exists());
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn results_record_the_binarys_build_and_merge_refuses_two_builds() {
+    let dir = temp_dir("build");
+    let commit = built_commit();
+    assert!(
+        commit == "unknown"
+            || (commit.len() == 40 && commit.chars().all(|c| c.is_ascii_hexdigit())),
+        "{commit}"
+    );
+    // Run from inside another repository: its HEAD is not the binary's commit.
+    let repo = dir.join("other-repo");
+    std::fs::create_dir_all(&repo).unwrap();
+    let git = |args: &[&str]| {
+        Command::new("git")
+            .args(args)
+            .current_dir(&repo)
+            .env("GIT_AUTHOR_NAME", "t")
+            .env("GIT_AUTHOR_EMAIL", "t@t")
+            .env("GIT_COMMITTER_NAME", "t")
+            .env("GIT_COMMITTER_EMAIL", "t@t")
+            .output()
+    };
+    let have_git = git(&["init", "-q"]).is_ok_and(|o| o.status.success())
+        && git(&["commit", "-q", "--allow-empty", "-m", "x"]).is_ok_and(|o| o.status.success());
+    let spec = spec_file(&dir, "tiny", TINY);
+    let out_dir = dir.join("out");
+    let o = Command::new(BIN)
+        .args(["sweep", s(&spec), "--out", s(&out_dir), "--no-progress"])
+        .current_dir(if have_git { &repo } else { &dir })
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let m = read_json(&out_dir.join("manifest.json"));
+    assert_eq!(m["git_commit"], commit.as_str(), "{m}");
+    if have_git {
+        let head = git(&["rev-parse", "HEAD"]).unwrap();
+        let head = String::from_utf8_lossy(&head.stdout).trim().to_string();
+        assert_ne!(
+            m["git_commit"],
+            head.as_str(),
+            "the cwd repository's HEAD was recorded"
+        );
+    }
+    // Two shards, one of them (as if) from another build: the merge refuses.
+    let shards: Vec<PathBuf> = (0..2)
+        .map(|i| {
+            let d = dir.join(format!("shard-{i}"));
+            let o = whirlmap(&[
+                "sweep",
+                s(&spec),
+                "--shard",
+                &i.to_string(),
+                "--shards",
+                "2",
+                "--out",
+                s(&d),
+                "--no-progress",
+            ]);
+            assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+            assert_eq!(
+                read_json(&d.join("shard.json"))["git_commit"],
+                commit.as_str()
+            );
+            d
+        })
+        .collect();
+    let shard_file = shards[1].join("shard.json");
+    let text = std::fs::read_to_string(&shard_file).unwrap();
+    std::fs::write(
+        &shard_file,
+        text.replace(
+            &format!("\"git_commit\": \"{commit}\""),
+            "\"git_commit\": \"0123456789abcdef0123456789abcdef01234567\"",
+        ),
+    )
+    .unwrap();
+    let merged = dir.join("merged");
+    let o = whirlmap(&["merge", s(&shards[0]), s(&shards[1]), "--out", s(&merged)]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(
+        stderr(&o).contains("different builds") && stderr(&o).contains("0123456789abcdef"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!merged.join("points.jsonl").exists());
+    std::fs::write(&shard_file, text).unwrap();
+    let o = whirlmap(&["merge", s(&shards[0]), s(&shards[1]), "--out", s(&merged)]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    assert_eq!(
+        read_json(&merged.join("manifest.json"))["git_commit"],
+        commit.as_str()
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -2,8 +2,9 @@
 //!
 //! The merge refuses, listing every problem it finds, when
 //! - a folder is not a shard's output (no `shard.json`), or the shards come from different
-//!   specs (spec hash), shard counts or model versions, or from another model version than
-//!   this binary's;
+//!   specs (spec hash), shard counts, model versions or builds (whirlmap version and commit:
+//!   a different commit may change results even under the same model version, so shards of
+//!   two builds are never joined), or from another model version than this binary's;
 //! - a grid point is missing (named with its index and inputs, grouped by the shard that owns
 //!   it, which is named with its folder and whether it finished), present twice, or not in
 //!   the spec's grid;
@@ -176,6 +177,18 @@ fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardDir>, MergeError> {
                  {MODEL_VERSION}: rerun the shard or merge with the same whirlmap",
                 s.dir.display(),
                 s.m.model_version
+            ));
+        }
+        if (&s.m.whirlmap_version, &s.m.git_commit)
+            != (&first.m.whirlmap_version, &first.m.git_commit)
+        {
+            problems.push(format!(
+                "the shards come from different builds: {} was run by whirlmap {}, {} by \
+                 whirlmap {} (rerun the shards with one build)",
+                first.dir.display(),
+                crate::build_info::describe(&first.m.whirlmap_version, &first.m.git_commit),
+                s.dir.display(),
+                crate::build_info::describe(&s.m.whirlmap_version, &s.m.git_commit)
             ));
         }
         if s.m.shards != first.m.shards {

@@ -106,6 +106,10 @@ pub struct ShardManifest {
     pub model_version: u32,
     /// The whirlmap package version of that binary.
     pub whirlmap_version: String,
+    /// The commit that binary was built from ([`crate::build_info::GIT_COMMIT`]); `unknown`
+    /// for a shard written by an older whirlmap.
+    #[serde(default = "unknown")]
+    pub git_commit: String,
     /// The grid points owned, in grid order.
     pub points: Vec<OwnedPoint>,
     /// Positions in `critical.mu` owned, increasing.
@@ -118,6 +122,10 @@ pub struct ShardManifest {
     pub complete: bool,
     /// The spec, as parsed.
     pub spec: SweepSpec,
+}
+
+fn unknown() -> String {
+    "unknown".to_string()
 }
 
 /// Stable FNV-1a 64 hash of the spec's canonical JSON (16 hex digits): shards of the same
@@ -145,7 +153,8 @@ pub fn shard_manifest(spec: &SweepSpec, shard: Shard) -> Result<ShardManifest, S
         shards: shard.count,
         spec_hash: spec_hash(spec),
         model_version: MODEL_VERSION,
-        whirlmap_version: env!("CARGO_PKG_VERSION").to_string(),
+        whirlmap_version: crate::build_info::VERSION.to_string(),
+        git_commit: crate::build_info::GIT_COMMIT.to_string(),
         points,
         critical_mu: owned(spec.critical.as_ref().map_or(0, |c| c.mus().len())),
         orbit_panels: owned(n_orbits),

@@ -239,6 +239,8 @@ struct Manifest<'a> {
     spec: &'a SweepSpec,
     whirlmap_version: &'static str,
     model_version: u32,
+    /// The commit the binary was built from ([`crate::build_info::GIT_COMMIT`]), not the
+    /// HEAD of the repository the command runs in.
     git_commit: Option<String>,
     started_unix_s: f64,
     ended_unix_s: f64,
@@ -266,19 +268,6 @@ pub(crate) fn unix_now() -> f64 {
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_secs_f64())
         .unwrap_or(0.0)
-}
-
-pub(crate) fn git_commit() -> Option<String> {
-    let out = std::process::Command::new("git")
-        .args(["rev-parse", "HEAD"])
-        .stderr(std::process::Stdio::null())
-        .output()
-        .ok()?;
-    if !out.status.success() {
-        return None;
-    }
-    let s = String::from_utf8(out.stdout).ok()?.trim().to_string();
-    (!s.is_empty()).then_some(s)
 }
 
 /// Progress reporting: an indicatif bar on a terminal, else a plain line every ~5 s.
@@ -545,7 +534,7 @@ pub(crate) fn write_summary_and_manifest(
     write_summary(&out.join(SUMMARY_FILE), points, &values)?;
     let manifest = Manifest {
         spec,
-        whirlmap_version: env!("CARGO_PKG_VERSION"),
+        whirlmap_version: crate::build_info::VERSION,
         model_version: MODEL_VERSION,
         git_commit: meta.git_commit,
         started_unix_s: meta.started_unix_s,
@@ -688,7 +677,7 @@ pub fn run_sweep_part(
     }
 
     let meta = RunMeta {
-        git_commit: git_commit(),
+        git_commit: Some(crate::build_info::GIT_COMMIT.to_string()),
         started_unix_s: started,
         ended_unix_s: unix_now(),
         threads,
