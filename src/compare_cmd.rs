@@ -1,6 +1,7 @@
 //! `whirlmap compare BASELINE NEW`: what changed between two sweep results (see
 //! `whirlmap_sweep::compare`). Exit codes: 0 the same within the thresholds; 1 changed beyond
-//! them; 2 error (a folder without points.jsonl, a bad option, an unwritable report).
+//! them; 2 error or refused (a folder without points.jsonl, a folder being written or holding
+//! a file its run did not write, a bad option, an unwritable report).
 
 use std::path::PathBuf;
 use whirlmap_sweep::compare::{compare, write_report, Thresholds};
@@ -41,6 +42,9 @@ pub fn run(a: &CompareArgs) -> u8 {
             return 2;
         }
     };
+    for w in &c.warnings {
+        errln!("warning: {w}");
+    }
     let out = a.out.clone().unwrap_or_else(|| a.new.join("compare.md"));
     let png = match write_report(&c, &out) {
         Ok(p) => p,

@@ -7,6 +7,7 @@
 use std::path::PathBuf;
 use whirlmap_sweep::adaptive::run_adaptive;
 use whirlmap_sweep::ensemble::{self, run_ensemble};
+use whirlmap_sweep::folder::FolderLock;
 use whirlmap_sweep::sweep::SweepError;
 
 /// Arguments of `whirlmap ensemble` and `whirlmap adaptive`.
@@ -30,20 +31,26 @@ pub struct EnsembleArgs {
 }
 
 fn code(e: &SweepError) -> u8 {
-    match e {
-        SweepError::Spec(_) | SweepError::ThreadPool(_) => 2,
-        SweepError::Io { .. } => 4,
-    }
+    e.exit_code()
 }
 
-fn load(a: &EnsembleArgs) -> Result<(ensemble::EnsembleSpec, PathBuf), u8> {
+/// Reads the file and takes the output folder's lock (one writer at a time; released when the
+/// returned lock is dropped, or the process ends).
+fn load(a: &EnsembleArgs, what: &str) -> Result<(ensemble::EnsembleSpec, PathBuf, FolderLock), u8> {
     match ensemble::load(&a.file) {
         Ok(s) => {
             let out = a
                 .out
                 .clone()
                 .unwrap_or_else(|| PathBuf::from("results").join(&s.name));
-            Ok((s, out))
+            let lock = std::fs::create_dir_all(&out)
+                .map_err(|e| whirlmap_sweep::folder::output_error(&out, e))
+                .and_then(|_| FolderLock::acquire(&out, what))
+                .map_err(|e| {
+                    errln!("error: {e}");
+                    e.exit_code()
+                })?;
+            Ok((s, out, lock))
         }
         Err(e) => {
             errln!("error: {e}");
@@ -58,7 +65,7 @@ fn fmt_speed(v: Option<f64>) -> String {
 
 /// Runs `whirlmap ensemble`.
 pub fn run_ensemble_cmd(a: &EnsembleArgs) -> u8 {
-    let (spec, out) = match load(a) {
+    let (spec, out, _lock) = match load(a, "ensemble") {
         Ok(x) => x,
         Err(c) => return c,
     };
@@ -115,7 +122,7 @@ pub fn run_ensemble_cmd(a: &EnsembleArgs) -> u8 {
 
 /// Runs `whirlmap adaptive`.
 pub fn run_adaptive_cmd(a: &EnsembleArgs) -> u8 {
-    let (spec, out) = match load(a) {
+    let (spec, out, _lock) = match load(a, "adaptive") {
         Ok(x) => x,
         Err(c) => return c,
     };

@@ -3,8 +3,9 @@
 //!
 //! Exit codes: 0 merged, every point ok; 1 merged, some point failed (recorded as data); 2
 //! refused (a point missing or present twice, shards of different specs, shard counts,
-//! model versions or builds, a folder that is not a shard's) with every problem listed; 4 an
-//! output could not be written.
+//! model versions or builds, a shard still running or with a file its manifest does not
+//! list, a folder that is not a shard's, an output folder holding another run's results
+//! without --overwrite) with every problem listed; 4 an output could not be written.
 
 use std::path::PathBuf;
 use whirlmap_sweep::merge::merge;
@@ -18,6 +19,11 @@ pub struct MergeArgs {
     /// Output folder; default: `results/<name>` of the shards' spec.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace the results already in the output folder (they are moved to
+    /// `previous-run/` until the merged records are written). Without it a folder holding
+    /// another run's results is refused.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// Runs the subcommand and returns the process exit code.
@@ -32,8 +38,11 @@ pub fn run(a: &MergeArgs) -> u8 {
             }
         },
     };
-    match merge(&a.dirs, &out) {
+    match merge(&a.dirs, &out, a.overwrite) {
         Ok(o) => {
+            for w in &o.warnings {
+                errln!("warning: {w}");
+            }
             outln!(
                 "merge {}: {} shards, {} points, {} ok, {} failed",
                 o.name,

@@ -26,6 +26,7 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> u8 {
         out_dir,
         threads: a.threads.map(|n| n as usize),
         resume: a.resume,
+        overwrite: a.overwrite,
         progress: if a.no_progress {
             ProgressMode::Off
         } else {
@@ -36,7 +37,7 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> u8 {
         Ok(o) => o,
         Err(e) => {
             errln!("error: {e}");
-            return if e.is_input() { 2 } else { 4 };
+            return e.exit_code();
         }
     };
     outln!(

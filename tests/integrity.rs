@@ -7,12 +7,24 @@ use common::*;
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// A grid of four short drops (the classifier's extension off, so each is 0.05 s).
 const TINY: &str = r#"{"name": "tiny", "scene": {"classification": {"max_extension_s": 0}},
   "duration_s": 0.05, "axes": {"speed_rpm": [4000, 8000], "mu": [0.1, 0.3]}}"#;
+
+/// Sixteen slow drops on one thread: a sweep that is still running a second after it started.
+const SLOW: &str = r#"{"name": "slow", "scene": {"solver": {"rtol": 1e-9}},
+  "duration_s": 1.0, "axes": {"speed_rpm": [2000, 4000, 6000, 8000], "mu": [0.1, 0.2, 0.3, 0.4]}}"#;
+
+/// A sweep with a small critical search and its Fig. 4.
+const WITH_CRITICAL: &str = r#"{"name": "withcrit",
+  "scene": {"classification": {"max_extension_s": 0}},
+  "duration_s": 0.05, "axes": {"speed_rpm": [4000, 8000], "mu": [0.1, 0.3]},
+  "critical": {"mu": [0.4], "speed_rpm": {"from": 2000, "to": 4000},
+               "resolution_rpm": 1000, "tol_rpm": 500},
+  "charts": ["critical", "classes"]}"#;
 
 /// [`TINY`] drawing `charts` (a JSON list).
 fn tiny_with_charts(charts: &str) -> String {
@@ -28,6 +40,42 @@ fn sweep(spec: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
 
 fn out_text(o: &std::process::Output) -> String {
     out(o)
+}
+
+fn spawn_sweep(spec: &Path, out: &Path, extra: &[&str]) -> Child {
+    Command::new(BIN)
+        .args([
+            "sweep",
+            s(spec),
+            "--out",
+            s(out),
+            "--no-progress",
+            "--threads",
+            "1",
+        ])
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits until `ready` holds (the child still running), at most 30 s.
+fn wait_until(child: &mut Child, what: &str, ready: impl Fn() -> bool) {
+    let start = Instant::now();
+    while !ready() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before {what}"
+        );
+        assert!(start.elapsed() < Duration::from_secs(30), "no {what}");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+fn manifest_names(out: &Path, name: &str) -> bool {
+    std::fs::read_to_string(out.join("manifest.json"))
+        .is_ok_and(|t| t.contains(&format!("\"name\": \"{name}\"")))
 }
 
 /// Runs `whirlmap` with standard output a pipe nobody reads (closed before it starts).
@@ -52,6 +100,220 @@ fn built_commit() -> String {
         .and_then(|t| t.split(')').next())
         .unwrap_or_else(|| panic!("no commit in --version: {text}"))
         .to_string()
+}
+
+#[test]
+fn a_second_writer_is_refused_and_a_killed_writer_leaves_no_lock() {
+    let dir = temp_dir("lock");
+    let (slow, tiny) = (spec_file(&dir, "slow", SLOW), spec_file(&dir, "tiny", TINY));
+    let out = dir.join("out");
+    let mut first = spawn_sweep(&slow, &out, &[]);
+    wait_until(&mut first, "the run took its folder", || {
+        manifest_names(&out, "slow")
+    });
+    // Another spec into the same folder, with or without --overwrite: refused, naming the
+    // holder, and nothing of the first run's is touched.
+    for extra in [&[][..], &["--overwrite"][..], &["--resume"][..]] {
+        let o = sweep(&tiny, &out, extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", out_text(&o));
+        let err = stderr(&o);
+        assert!(
+            err.contains("in use by another whirlmap")
+                && err.contains(&format!("pid {}", first.id())),
+            "{err}"
+        );
+    }
+    // `render` waits its turn too.
+    let o = whirlmap(&["render", s(&out)]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(stderr(&o).contains("in use"), "{}", stderr(&o));
+    assert!(manifest_names(&out, "slow"));
+    // kill -9: the operating system drops the lock, so the folder is free at once.
+    first.kill().unwrap();
+    first.wait().unwrap();
+    let o = sweep(&tiny, &out, &["--overwrite"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let m = read_json(&out.join("manifest.json"));
+    assert_eq!(m["spec"]["name"], "tiny");
+    assert_eq!(m["complete"], true);
+    let recs = std::fs::read_to_string(out.join("points.jsonl")).unwrap();
+    assert_eq!(recs.lines().count(), 4, "{recs}");
+    for l in recs.lines() {
+        let v: Value = serde_json::from_str(l).expect("whole lines of one run");
+        assert_eq!(v["duration_s"], 0.05);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn resume_refuses_an_edited_spec_and_says_what_changed() {
+    let dir = temp_dir("resume-edited");
+    let spec = spec_file(&dir, "tiny", TINY);
+    let out = dir.join("out");
+    let o = sweep(&spec, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let before = std::fs::read(out.join("points.jsonl")).unwrap();
+    let cases = [
+        (
+            "a new duration",
+            TINY.replace("0.05,", "0.04,"),
+            "duration_s: 0.05 -> 0.04",
+        ),
+        (
+            "a narrowed axis",
+            TINY.replace("[0.1, 0.3]", "[0.1]"),
+            "axes.mu: [0.1,0.3] -> [0.1]",
+        ),
+        (
+            "reordered axes",
+            TINY.replace(
+                r#""speed_rpm": [4000, 8000], "mu": [0.1, 0.3]"#,
+                r#""mu": [0.1, 0.3], "speed_rpm": [4000, 8000]"#,
+            ),
+            "axes: order speed_rpm, mu -> mu, speed_rpm",
+        ),
+    ];
+    for (what, text, needle) in cases {
+        assert_ne!(text, TINY, "{what}: the edit applies");
+        let edited = spec_file(&dir, "edited", &text);
+        let o = sweep(&edited, &out, &["--resume"]);
+        assert_eq!(o.status.code(), Some(2), "{what}: {}", out_text(&o));
+        let err = stderr(&o);
+        assert!(
+            err.contains("cannot resume") && err.contains(needle),
+            "{what}: `{needle}` not in {err}"
+        );
+        assert!(
+            std::fs::read(out.join("points.jsonl")).unwrap() == before,
+            "{what}: records changed"
+        );
+    }
+    // The same spec resumes (nothing left to run).
+    let o = sweep(&spec, &out, &["--resume"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("(4 resumed)"));
+    assert!(std::fs::read(out.join("points.jsonl")).unwrap() == before);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_rerun_is_refused_and_an_overwrite_keeps_the_old_records_until_its_first_chunk() {
+    let dir = temp_dir("rerun");
+    let (tiny, slow) = (spec_file(&dir, "tiny", TINY), spec_file(&dir, "slow", SLOW));
+    let out = dir.join("out");
+    let o = sweep(&tiny, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let old = std::fs::read(out.join("points.jsonl")).unwrap();
+    // Without --resume or --overwrite: refused, and the records stay.
+    for spec in [&tiny, &slow] {
+        let o = sweep(spec, &out, &[]);
+        assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+        let err = stderr(&o);
+        assert!(
+            err.contains("holds the results of another run")
+                && err.contains("--resume")
+                && err.contains("--overwrite"),
+            "{err}"
+        );
+        assert!(std::fs::read(out.join("points.jsonl")).unwrap() == old);
+    }
+    // An overwrite killed before its first chunk: the old records are kept aside.
+    let mut child = spawn_sweep(&slow, &out, &["--overwrite"]);
+    wait_until(&mut child, "the overwrite took its folder", || {
+        manifest_names(&out, "slow")
+    });
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let kept = out.join("previous-run/points.jsonl");
+    assert!(
+        std::fs::read(&kept).unwrap() == old,
+        "the old records are not kept in previous-run/"
+    );
+    // Killed again before a chunk: still kept (not replaced by the empty records).
+    let mut child = spawn_sweep(&slow, &out, &["--overwrite"]);
+    let pid = format!("pid {}:", child.id());
+    wait_until(&mut child, "the second overwrite took its folder", || {
+        std::fs::read_to_string(out.join(".whirlmap.lock")).is_ok_and(|t| t.starts_with(&pid))
+    });
+    // Its preparation takes milliseconds, its first chunk of four slow drops seconds.
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(child.try_wait().unwrap().is_none());
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(std::fs::read(&kept).unwrap() == old);
+    // An overwrite that writes its records removes them.
+    let o = sweep(&tiny, &out, &["--overwrite"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    assert!(!out.join("previous-run").exists());
+    assert!(std::fs::read(out.join("points.jsonl")).unwrap() == old);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_run_owns_its_folder_and_stale_files_are_never_used() {
+    let dir = temp_dir("stale");
+    let a = spec_file(&dir, "a", WITH_CRITICAL);
+    let b = spec_file(&dir, "b", &tiny_with_charts(r#"["classes"]"#));
+    let out = dir.join("out");
+    let o = sweep(&a, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let m = read_json(&out.join("manifest.json"));
+    assert_eq!(m["complete"], true);
+    let hash_a = m["spec_hash"].as_str().unwrap().to_string();
+    for f in [
+        "points.jsonl",
+        "summary.csv",
+        "critical.json",
+        "critical.csv",
+        "charts/fig4_critical.png",
+        "charts/classes.svg",
+    ] {
+        assert!(m["files"][f]["fnv1a64"].is_string(), "{f} not listed: {m}");
+    }
+    let stale = dir.join("critical-of-a.json");
+    std::fs::copy(out.join("critical.json"), &stale).unwrap();
+
+    // Another spec without a critical search: the old critical.json and Fig. 4 are gone.
+    let o = sweep(&b, &out, &["--overwrite"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let m = read_json(&out.join("manifest.json"));
+    assert_ne!(m["spec_hash"].as_str().unwrap(), hash_a);
+    for f in ["critical.json", "critical.csv", "charts/fig4_critical.png"] {
+        assert!(
+            !out.join(f).exists(),
+            "{f} of the earlier spec is still there"
+        );
+    }
+    let o = whirlmap(&["render", s(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("fig4"));
+    assert!(!out.join("charts/fig4_critical.png").exists());
+
+    // A stale file put back is refused by render and compare, named.
+    std::fs::copy(&stale, out.join("critical.json")).unwrap();
+    let o = whirlmap(&["render", s(&out)]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(
+        stderr(&o).contains("critical.json") && stderr(&o).contains("not written by the run"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.join("charts/fig4_critical.png").exists());
+    let base = dir.join("base");
+    let o = sweep(&b, &base, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let o = whirlmap(&["compare", s(&base), s(&out), "--out", s(&dir.join("c.md"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(stderr(&o).contains("critical.json"), "{}", stderr(&o));
+    // A listed file changed after the run is refused too.
+    std::fs::remove_file(out.join("critical.json")).unwrap();
+    let mut text = std::fs::read_to_string(out.join("points.jsonl")).unwrap();
+    text = text.replacen("\"status\":\"ok\"", "\"status\":\"failed\"", 1);
+    std::fs::write(out.join("points.jsonl"), text).unwrap();
+    let o = whirlmap(&["render", s(&out)]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(stderr(&o).contains("changed afterwards"), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -353,6 +615,7 @@ fn a_closed_stdout_ends_quietly_and_the_work_is_finished() {
         out_dir.join("charts/classes.png").is_file(),
         "the charts were skipped"
     );
+    assert_eq!(read_json(&out_dir.join("manifest.json"))["complete"], true);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -614,10 +614,7 @@ pub fn run_adaptive(
     };
     let path = out_dir.join(ADAPTIVE_FILE);
     let text = serde_json::to_string_pretty(&report).expect("report serialises");
-    std::fs::write(&path, format!("{text}\n")).map_err(|source| SweepError::Io {
-        path: path.clone(),
-        source,
-    })?;
+    crate::folder::write_atomic(&path, format!("{text}\n").as_bytes())?;
     Ok((report, path))
 }
 

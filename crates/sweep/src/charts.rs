@@ -1345,7 +1345,29 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         )?;
     }
     written.extend(prob);
+    remove_stale_charts(&out_dir, &written)?;
     Ok(written)
+}
+
+/// Removes the charts in `dir` that this rendering did not draw (a Fig. 4 left from an
+/// earlier spec with a critical search, say), so `charts/` shows only what the data holds.
+fn remove_stale_charts(dir: &Path, written: &[PathBuf]) -> Result<(), ChartError> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        let chart = p
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("png") || x.eq_ignore_ascii_case("svg"));
+        if chart && p.is_file() && !written.iter().any(|w| w == &p) {
+            std::fs::remove_file(&p).map_err(|cause| ChartError::Write {
+                path: p.clone(),
+                cause,
+            })?;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -10,6 +10,10 @@
 //!   and not in the other is a change as well. Overlapping brackets are "the same": the search
 //!   cannot tell the speeds apart.
 //!
+//! - Each folder is checked first ([`crate::folder::check_inputs`]): a file its run did not
+//!   write is refused, a folder being written is refused, a folder that cannot be checked or
+//!   a run that did not finish is said loudly.
+//!
 //! [`compare`] returns the findings; [`write_report`] writes them as Markdown with a class map
 //! of the new run whose changed cells are outlined.
 
@@ -102,6 +106,9 @@ pub struct Comparison {
     pub critical: Vec<CriticalChange>,
     /// Both runs' manifests' `spec.name`, `model_version` (for the report header).
     pub runs: [RunInfo; 2],
+    /// What could not be checked or is partial (a folder without a manifest, a run that did
+    /// not finish), to be said loudly.
+    pub warnings: Vec<String>,
     /// The new run's rows (for the class map).
     new_rows: Vec<PointRow>,
 }
@@ -122,6 +129,18 @@ pub struct RunInfo {
     pub model_version: String,
     /// The git commit, if recorded.
     pub git_commit: String,
+}
+
+/// Why two results cannot be compared.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    /// A folder's points or critical speeds could not be read.
+    #[error(transparent)]
+    Read(#[from] ChartError),
+    /// The folders cannot be compared: a folder being written, a file its run did not
+    /// write. Every reason, one per entry.
+    #[error("compare refused:\n  - {}", .0.join("\n  - "))]
+    Refused(Vec<String>),
 }
 
 fn run_info(dir: &Path) -> RunInfo {
@@ -268,9 +287,33 @@ fn compare_critical(base: &[CriticalRow], new: &[CriticalRow]) -> (usize, Vec<Cr
     (compared, changes)
 }
 
+/// Checks a folder before it is compared: not being written, and every file it holds is its
+/// run's ([`crate::folder::check_inputs`]). Returns its warnings.
+fn check_folder(dir: &Path) -> Result<Vec<String>, Vec<String>> {
+    if let Some(who) = crate::folder::running_writer(dir) {
+        return Err(vec![format!(
+            "{} is being written by a running whirlmap ({who}): compare it when that run has \
+             finished",
+            dir.display()
+        )]);
+    }
+    crate::folder::check_inputs(dir, &crate::folder::reader_inputs(dir)).map(|c| c.warnings)
+}
+
 /// Compares the result folders `baseline` and `new` (each with `points.jsonl`, optionally
 /// `critical.json` and `manifest.json`).
-pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison, ChartError> {
+pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison, CompareError> {
+    let mut warnings = Vec::new();
+    let mut refused = Vec::new();
+    for dir in [baseline, new] {
+        match check_folder(dir) {
+            Ok(w) => warnings.extend(w),
+            Err(p) => refused.extend(p),
+        }
+    }
+    if !refused.is_empty() {
+        return Err(CompareError::Refused(refused));
+    }
     let base_rows = load_points(baseline)?;
     let new_rows = load_points(new)?;
     let mut base_by: BTreeMap<String, &PointRow> = BTreeMap::new();
@@ -345,6 +388,7 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
         critical_compared,
         critical,
         runs: [run_info(baseline), run_info(new)],
+        warnings,
         new_rows,
     })
 }
@@ -397,6 +441,9 @@ pub fn write_report(c: &Comparison, path: &Path) -> Result<PathBuf, ChartError> 
         c.critical.len(),
         c.critical_compared
     );
+    for w in &c.warnings {
+        let _ = writeln!(md, "**Warning**: {w}\n");
+    }
     let _ = writeln!(md, "| | baseline | new |\n|---|---|---|");
     let _ = writeln!(
         md,

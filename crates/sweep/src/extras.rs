@@ -22,6 +22,8 @@ pub enum ExtrasError {
     },
 }
 
+/// Writes `text` to `path` all or nothing ([`crate::folder::write_atomic`]), creating its
+/// folder.
 fn write(path: &Path, text: &str) -> Result<(), ExtrasError> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|source| ExtrasError::Io {
@@ -29,10 +31,20 @@ fn write(path: &Path, text: &str) -> Result<(), ExtrasError> {
             source,
         })?;
     }
-    std::fs::write(path, text).map_err(|source| ExtrasError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    crate::folder::write_atomic(path, text.as_bytes()).map_err(ExtrasError::from_sweep)
+}
+
+impl ExtrasError {
+    /// The same failure from the sweep's writers.
+    pub fn from_sweep(e: crate::sweep::SweepError) -> Self {
+        match e {
+            crate::sweep::SweepError::Io { path, source } => ExtrasError::Io { path, source },
+            other => ExtrasError::Io {
+                path: PathBuf::new(),
+                source: std::io::Error::other(other.to_string()),
+            },
+        }
+    }
 }
 
 /// The files the extras wrote.
@@ -99,13 +111,7 @@ pub fn run_probability(
         return Ok(None);
     };
     let dir = out_dir.join(PROBABILITY_DIR);
-    crate::ensemble::run_ensemble(&e, &dir, threads, progress).map_err(|err| match err {
-        crate::sweep::SweepError::Io { path, source } => ExtrasError::Io { path, source },
-        other => ExtrasError::Io {
-            path: dir.clone(),
-            source: std::io::Error::other(other.to_string()),
-        },
-    })?;
+    crate::ensemble::run_ensemble(&e, &dir, threads, progress).map_err(ExtrasError::from_sweep)?;
     Ok(Some(dir))
 }
 

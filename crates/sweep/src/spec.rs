@@ -550,6 +550,23 @@ fn check_range(field: &str, from: f64, to: f64) -> Result<(), SpecError> {
     }
 }
 
+/// Reads and parses a spec and checks everything but the grid points' scenes
+/// ([`SweepSpec::validate`]: the grid's size first, before any axis is built). A sweep checks
+/// the points' scenes itself before it runs ([`crate::sweep::run_sweep`]), one at a time.
+pub fn read(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|source| SpecError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let spec = parse(&text).map_err(|source| SpecError::Parse {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    spec.validate()?;
+    Ok(spec)
+}
+
 /// Reads, parses and validates a spec (every grid point's scene included).
 pub fn load(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
     let path = path.as_ref();
@@ -842,7 +859,8 @@ impl SweepSpec {
     }
 
     /// Every grid point, row-major (first axis slowest), each scene validated. This holds
-    /// the whole grid in memory; [`SweepSpec::grid`] builds one point at a time.
+    /// the whole grid in memory: for small grids (an ensemble's cells, tests); a sweep
+    /// builds its points chunk by chunk with [`SweepSpec::grid`].
     pub fn points(&self) -> Result<Vec<Point>, SpecError> {
         let grid = self.grid()?;
         (0..grid.len()).map(|i| grid.point(i)).collect()
