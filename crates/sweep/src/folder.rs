@@ -76,6 +76,24 @@ const DERIVED: &[&str] = &[
 /// removed by the next run that takes the lock.
 const TMP_SUFFIX: &str = ".whirlmap-tmp";
 
+/// Whether an I/O error is a failure of the storage (disk full, quota, an I/O error: exit 4)
+/// rather than a bad output path (a file in the way, no permission, a read-only file
+/// system: exit 2).
+pub fn is_storage_error(e: &std::io::Error) -> bool {
+    use std::io::ErrorKind as K;
+    !matches!(
+        e.kind(),
+        K::NotFound
+            | K::PermissionDenied
+            | K::AlreadyExists
+            | K::NotADirectory
+            | K::IsADirectory
+            | K::ReadOnlyFilesystem
+            | K::InvalidFilename
+            | K::InvalidInput
+    )
+}
+
 /// An advisory lock on a results folder, held until dropped (or the process ends).
 #[derive(Debug)]
 pub struct FolderLock {
@@ -144,12 +162,20 @@ pub fn running_writer(dir: &Path) -> Option<String> {
     }
 }
 
-/// The error for an output folder that cannot be created or written (exit 2).
+/// The error for an output folder that cannot be created or written: bad input (exit 2) for
+/// a bad path, an I/O error (exit 4) when the storage failed.
 pub fn output_error(dir: &Path, source: std::io::Error) -> SweepError {
-    SweepError::Spec(crate::spec::SpecError::Output {
-        path: dir.to_path_buf(),
-        source,
-    })
+    if is_storage_error(&source) {
+        SweepError::Io {
+            path: dir.to_path_buf(),
+            source,
+        }
+    } else {
+        SweepError::Spec(crate::spec::SpecError::Output {
+            path: dir.to_path_buf(),
+            source,
+        })
+    }
 }
 
 /// Writes `bytes` to `path` all or nothing: into a temporary file beside it, synced, renamed

@@ -914,17 +914,20 @@ fn grid_size_text(axes: &Axes) -> String {
 }
 
 /// Creates `dir` (and parents) and writes and removes a probe file, so an unwritable output
-/// folder is reported before any drop runs.
-pub fn check_output_dir(dir: &Path) -> Result<(), SpecError> {
-    let err = |source| SpecError::Output {
-        path: dir.to_path_buf(),
-        source,
-    };
+/// folder is reported before any drop runs: a bad path (a file in the way, no permission) as
+/// [`SpecError::Output`] (exit 2), a storage failure (a full disk) as
+/// [`crate::sweep::SweepError::Io`] (exit 4). The probe is removed whatever happens.
+pub fn check_output_dir(dir: &Path) -> Result<(), crate::sweep::SweepError> {
+    let err = |source| crate::folder::output_error(dir, source);
     std::fs::create_dir_all(dir).map_err(err)?;
     let probe = dir.join(format!(".whirlmap-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"probe").map_err(err)?;
-    std::fs::remove_file(&probe).map_err(err)?;
-    Ok(())
+    let written = std::fs::write(&probe, b"probe");
+    let removed = std::fs::remove_file(&probe);
+    written.map_err(err)?;
+    match removed {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(err(e)),
+        _ => Ok(()),
+    }
 }
 
 #[cfg(test)]
@@ -1138,7 +1141,11 @@ mod tests {
         let file = dir.join("a-file");
         std::fs::write(&file, "x").unwrap();
         let e = check_output_dir(&file.join("sub")).unwrap_err();
-        assert!(matches!(e, SpecError::Output { .. }), "{e}");
+        assert!(
+            matches!(e, crate::sweep::SweepError::Spec(SpecError::Output { .. })),
+            "{e}"
+        );
+        assert_eq!(e.exit_code(), 2);
         check_output_dir(&dir.join("out")).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }

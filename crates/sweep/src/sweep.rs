@@ -9,7 +9,8 @@
 //! ## Crash safety and resume
 //! The grid runs in chunks of `4 x threads` points; within a chunk points run in parallel and
 //! their lines are appended in grid order, each line with a single `write_all`, then flushed
-//! when the chunk ends. A kill loses at most the chunk in flight. `resume` reads the existing file, drops a torn last line (truncating
+//! and synced to disk (`fsync`) when the chunk ends. A kill, or a power loss, loses at most
+//! the chunk in flight. `resume` reads the existing file, drops a torn last line (truncating
 //! the file back to the last complete line), skips points recorded `ok` at their grid index,
 //! re-runs failed ones, and at the end rewrites the file in grid order with one line per
 //! point, so it is byte-identical to an uninterrupted run.
@@ -870,10 +871,12 @@ pub fn run_grid(
                 );
             }
         }
-        // The chunk's lines, flushed: a kill keeps every chunk before the one in flight.
+        // The chunk's lines, flushed and synced: a power loss keeps every chunk before the
+        // one in flight.
         points_file
             .write_all(text.as_bytes())
             .and_then(|_| points_file.flush())
+            .and_then(|_| points_file.sync_data())
             .map_err(io_err(&points_path))?;
         timings_file
             .write_all(times.as_bytes())
