@@ -1,7 +1,8 @@
 //! `whirlmap compare BASELINE NEW`: what changed between two sweep results (see
 //! `whirlmap_sweep::compare`). Exit codes: 0 the same within the thresholds; 1 changed beyond
-//! them; 2 error or refused (a folder without points.jsonl, a folder being written or holding
-//! a file its run did not write, a bad option, an unwritable report).
+//! them; 2 error or refused (a folder without points.jsonl, nothing comparable, a folder
+//! being written or holding a file its run did not write, a bad option, an unwritable
+//! report). Differences between the two specs are always printed.
 
 use std::path::PathBuf;
 use whirlmap_sweep::compare::{compare, write_report, Thresholds};
@@ -54,13 +55,24 @@ pub fn run(a: &CompareArgs) -> u8 {
         }
     };
     outln!(
-        "compare: {}: {} of {} points and {} of {} critical speeds changed",
+        "compare: {}: {} of {} points and {} of {} critical speeds changed{}",
         if c.changed() { "CHANGED" } else { "same" },
         c.points.len(),
         c.points_compared,
         c.critical.len(),
-        c.critical_compared
+        c.critical_compared,
+        if c.spec_differences.is_empty() {
+            ""
+        } else {
+            " (the specs differ)"
+        }
     );
+    for d in &c.spec_differences {
+        outln!("  spec differs     {d}");
+    }
+    for d in &c.not_comparable {
+        outln!("  not comparable   {d}");
+    }
     for p in &c.points {
         outln!("  point {}: {}", p.inputs, p.what.join("; "));
     }

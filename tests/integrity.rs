@@ -754,3 +754,54 @@ fn results_record_the_binarys_build_and_merge_refuses_two_builds() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn compare_refuses_incomparable_runs_and_states_spec_differences() {
+    let dir = temp_dir("incomparable");
+    let run = |name: &str, text: &str| {
+        let spec = spec_file(&dir, name, text);
+        let out_dir = dir.join(name);
+        let o = sweep(&spec, &out_dir, &[]);
+        assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+        out_dir
+    };
+    let a = run("a", TINY);
+    let shorter = run("shorter", &TINY.replace("0.05,", "0.04,"));
+    let o = whirlmap(&["compare", s(&a), s(&shorter), "--out", s(&dir.join("1.md"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("nothing to compare") && err.contains("duration_s: 0.05 -> 0.04"),
+        "{err}"
+    );
+    // Two folders of garbage.
+    let (g1, g2) = (dir.join("g1"), dir.join("g2"));
+    for (g, t) in [(&g1, "garbage\n"), (&g2, "{\"not\": \"a record\"}\n")] {
+        std::fs::create_dir_all(g).unwrap();
+        std::fs::write(g.join("points.jsonl"), t).unwrap();
+    }
+    let o = whirlmap(&["compare", s(&g1), s(&g2), "--out", s(&dir.join("2.md"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("same"));
+    // Comparable runs of different specs: compared, and the difference said.
+    let tight = run(
+        "tight",
+        &TINY.replace(r#""scene": {"#, r#""scene": {"solver": {"rtol": 1e-7}, "#),
+    );
+    let report = dir.join("3.md");
+    let o = whirlmap(&["compare", s(&a), s(&tight), "--out", s(&report)]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", out_text(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("the specs differ")
+            && stdout.contains("spec differs     scene.solver.rtol: ")
+            && stdout.contains(" -> 1e-7"),
+        "{stdout}"
+    );
+    let md = std::fs::read_to_string(&report).unwrap();
+    assert!(
+        md.contains("## The specs differ") && md.contains("scene.solver.rtol"),
+        "{md}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
