@@ -128,9 +128,14 @@ fn a_second_writer_is_refused_and_a_killed_writer_leaves_no_lock() {
     assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
     assert!(stderr(&o).contains("in use"), "{}", stderr(&o));
     assert!(manifest_names(&out, "slow"));
-    // kill -9: the operating system drops the lock, so the folder is free at once.
+    // kill -9: the operating system drops the lock, so the folder is free at once, and what
+    // it left is said to be partial.
     first.kill().unwrap();
     first.wait().unwrap();
+    let o = whirlmap(&["render", s(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    assert!(stderr(&o).contains("did not finish"), "{}", stderr(&o));
+    assert_eq!(read_json(&out.join("manifest.json"))["complete"], false);
     let o = sweep(&tiny, &out, &["--overwrite"]);
     assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
     let m = read_json(&out.join("manifest.json"));

@@ -22,9 +22,10 @@
 //! last stage is written. A reader ([`check_inputs`]) accepts a derived file (`critical.json`,
 //! `orbits/`, `probability/`, `points.jsonl` of a finished run) only when the manifest lists
 //! it with that size and hash: a file from an earlier spec, copied in or edited afterwards,
-//! is refused, naming the file. Folders without a manifest, or with one from an earlier
-//! whirlmap that has no file list, are read as before with a warning that they cannot be
-//! checked.
+//! is refused, naming the file. In a run that did not finish, a file not yet listed is read
+//! with a warning (the run started from a folder without another run's files). Folders
+//! without a manifest, or with one from an earlier whirlmap that has no file list, are read
+//! as before with a warning that they cannot be checked.
 
 use crate::spec::SweepSpec;
 use crate::sweep::{io_err, SweepError, MANIFEST_FILE, POINTS_FILE, TIMINGS_FILE};
@@ -830,6 +831,12 @@ pub fn check_inputs(dir: &Path, inputs: &[String]) -> Result<Checked, Vec<String
             }
             // The records of a run in progress or killed: not listed until the grid ends.
             None if !complete && (rel == POINTS_FILE || rel == TIMINGS_FILE) => {}
+            // A run that did not finish lists a file only once its stage is done; the folder
+            // held none of another run's files when it started.
+            None if !complete => checked.warnings.push(format!(
+                "{} is not listed by the run that did not finish: it cannot be checked",
+                path.display()
+            )),
             None => problems.push(format!(
                 "{} was not written by the run recorded in {} (spec \"{name}\", hash {hash}): \
                  a stale file of an earlier run; remove it, or rerun the sweep with \
