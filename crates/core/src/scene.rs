@@ -309,6 +309,26 @@ pub fn num(v: f64) -> String {
     }
 }
 
+/// A derived number for a message, to three significant digits (`45.3`, `4.53e-7`): the
+/// bounds and values a check computes, as opposed to [`num`]'s exact echo of an input.
+fn approx(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !a.is_finite() {
+        return v.to_string();
+    }
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+        let text = format!("{v:.decimals$}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
 /// 2.47e5 N/mm^1.5 in N/m^1.5: 1 N/mm^1.5 = 1000^1.5 N/m^1.5.
 const K2_TABLE4_N_PER_M15: f64 = 2.47e5 * 31_622.776_601_683_792;
 
@@ -665,7 +685,7 @@ impl Scene {
                 &format!(
                     "> the race bore diameter rotor_diameter_m + 2 clearance_m = {} m (the \
                      bearing's balls run outside its bore)",
-                    num(bore_d)
+                    approx(bore_d)
                 ),
             ));
         }
@@ -696,11 +716,11 @@ impl Scene {
                     &format!(
                         "a radius of gyration sqrt({field} / {mass_field}) within [{lo}, {hi}] \
                          x {what} ({} m), i.e. [{}, {}] kg m^2 with {mass_field} = {}; here {} m",
-                        num(radius),
-                        num(mass * (lo * radius).powi(2)),
-                        num(mass * (hi * radius).powi(2)),
+                        approx(radius),
+                        approx(mass * (lo * radius).powi(2)),
+                        approx(mass * (hi * radius).powi(2)),
                         num(mass),
-                        num(gyration)
+                        approx(gyration)
                     ),
                 ));
             }
@@ -732,10 +752,10 @@ impl Scene {
                         "a stiffness in N/m^e ({exp_field} e = {}) whose force at 1 um \
                          penetration, k (1e-6 m)^e, is in [{}, {}] N ({table}); here {} N. A \
                          stiffness in N/mm^e is 1000^e times too small",
-                        num(e),
+                        approx(e),
                         num(lo),
                         num(hi),
-                        num(f)
+                        approx(f)
                     ),
                 ));
             }
@@ -807,6 +827,18 @@ mod tests {
         assert_ne!(a.hash_hex(), b.hash_hex());
         // Pinned: a change here means every stored record key changes; bump MODEL_VERSION.
         assert_eq!(a.hash_hex().len(), 16);
+    }
+
+    #[test]
+    fn derived_numbers_in_messages_have_three_digits() {
+        assert_eq!(approx(45.312587499999), "45.3");
+        assert_eq!(approx(0.0123456), "0.0123");
+        assert_eq!(approx(0.04), "0.04");
+        assert_eq!(approx(2.0), "2");
+        assert_eq!(approx(10.0 / 9.0), "1.11");
+        assert_eq!(approx(4.53125875e-7), "4.53e-7");
+        assert_eq!(num(1e308), "1e308");
+        assert_eq!(num(0.15), "0.15");
     }
 
     #[test]
