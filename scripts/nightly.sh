@@ -21,7 +21,9 @@ spec=${NIGHTLY_SPEC:-sweeps/nightly.json}
 baseline=${NIGHTLY_BASELINE:-results/nightly-baseline}
 out=${1:-results/nightly-runs/$(date -u +%Y-%m-%d)}
 
-"$whirlmap" sweep "$spec" --out "$out" --no-progress
+# --overwrite: a second run into the same OUT (the same day) replaces the first; its files
+# are kept in OUT/previous-run/ until the new run's first records are written.
+"$whirlmap" sweep "$spec" --out "$out" --overwrite --no-progress
 rc=$?
 # 1: some points failed; they are recorded and the comparison reports them.
 if [ $rc -ne 0 ] && [ $rc -ne 1 ]; then

@@ -41,7 +41,7 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
                 .iter()
                 .map(|s| s.rtol.as_ref().unwrap_or(&spec.rtol).len())
                 .sum::<usize>());
-    eprintln!(
+    errln!(
         "whirlmap accuracy: {} cases, {} settings, {jobs} drops on {} thread(s)",
         spec.cases.len(),
         spec.settings.len(),
@@ -74,7 +74,7 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
             draw_work_precision(&p, &study, axis, &title).map_err(|e| Failure::Output(e.into()))?;
         }
     }
-    println!("{md}");
-    eprintln!("written to {}", a.out.display());
+    outln!("{md}");
+    errln!("written to {}", a.out.display());
     Ok(())
 }

@@ -114,12 +114,12 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             edit: |_| {},
         },
     ];
-    println!(
+    outln!(
         "whirlmap bench: one thread, the fastest of {reps} runs after a warm-up (wall ms); \
          ratios to the baseline (first row) and to the peer (a numba DOPRI5 of the same model, \
          {PEER_MS} ms for the baseline drop at rtol 1e-6; see the note below the table)"
     );
-    println!(
+    outln!(
         "{:<40} {:>8} {:>7} {:>7} {:>9} {:>7} {:>6} {:>6} {:>6} {:>6} {:>7} {:>12}",
         "case",
         "ms",
@@ -175,7 +175,7 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         let peer = ms / dopri * DOPRI5_OVER_PEER;
         print_row(name, *ms, ms / base, peer, r, *evals);
     }
-    println!(
+    outln!(
         "x peer: the row's time over the dopri5 rtol 1e-5 row's, times {DOPRI5_OVER_PEER} (that row \
          against the peer in the side-by-side measurement); against the peer's {PEER_MS} ms \
          directly the baseline reads {:.3}. The peer takes {PEER_RHS} RHS evaluations.",
@@ -221,7 +221,7 @@ fn rhs_cost() {
             }
             best = best.min(t.elapsed().as_secs_f64());
         }
-        println!(
+        outln!(
             "one RHS evaluation (contact, {label}, drag on): {:.1} ns (fastest of 5 batches of {n})",
             best * 1e9 / n as f64
         );
@@ -238,7 +238,7 @@ fn print_row(name: &str, ms: f64, x_base: f64, x_peer: f64, r: &DropReport, eval
         ""
     };
     let st = &r.stats;
-    println!(
+    outln!(
         "{:<40} {:>8.2} {:>7.3} {:>7.3} {:>9} {:>7} {:>6} {:>6} {:>6} {:>6} {:>7.0} {:>12}{note}",
         name,
         ms,
@@ -290,7 +290,7 @@ fn long_thermal_run(name: &str, scene: &Scene, duration_s: f64) -> anyhow::Resul
     );
     let th = r.thermal.as_ref().expect("a thermal scene");
     let per_60 = |x: f64| x * 60.0 / r.end_time_s;
-    println!(
+    outln!(
         "    {:.2} s simulated ({:?}): {:.0} dynamic RHS evaluations and {:.0} network steps per simulated second; \
          CPU {} ({} per 60 s simulated)",
         r.end_time_s,
@@ -323,7 +323,7 @@ fn print_thermal_differences(full: &DropReport, draft: &DropReport) {
         })
         .fold(0.0, f64::max);
     let (ha, hb) = (a.heat, b.heat);
-    println!(
+    outln!(
         "    draft vs full: largest node temperature difference (final or peak) {:.4} K = {:.1e} of the {:.2} K rise; \
          peak F_th {:.3} vs {:.3} N",
         d_t,
@@ -332,7 +332,7 @@ fn print_thermal_differences(full: &DropReport, draft: &DropReport) {
         b.peak_thermal_load_n,
         a.peak_thermal_load_n
     );
-    println!(
+    outln!(
         "    heat H_s {:.3} vs {:.3} J, H_i {:.3} vs {:.3} J, H_o {:.3} vs {:.3} J; end {:.3} vs {:.3} s, \
          rotor {:.1} vs {:.1} r/min, race {:.1} vs {:.1} r/min",
         hb.h_s_j,

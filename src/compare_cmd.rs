@@ -1,9 +1,10 @@
 //! `whirlmap compare BASELINE NEW`: what changed between two sweep results (see
 //! `whirlmap_sweep::compare`). Exit codes: 0 the same within the thresholds; 1 changed beyond
-//! them; 2 error (a folder without points.jsonl, a bad option, an unwritable report).
+//! them; 2 error or refused (a folder without points.jsonl, nothing comparable, a folder
+//! being written or holding a file its run did not write, a bad option, an unwritable
+//! report). Differences between the two specs are always printed.
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 use whirlmap_sweep::compare::{compare, write_report, Thresholds};
 
 /// Arguments of `whirlmap compare`.
@@ -26,49 +27,63 @@ pub struct CompareArgs {
 }
 
 /// Runs the subcommand and returns the process exit code.
-pub fn run(a: &CompareArgs) -> ExitCode {
+pub fn run(a: &CompareArgs) -> u8 {
     let t = Thresholds {
         force_rel: a.force_rel,
         power_rel: a.power_rel,
     };
     if let Err(e) = t.validate() {
-        eprintln!("error: {e}");
-        return ExitCode::from(2);
+        errln!("error: {e}");
+        return 2;
     }
     let c = match compare(&a.baseline, &a.new, t) {
         Ok(c) => c,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            errln!("error: {e}");
+            return 2;
         }
     };
+    for w in &c.warnings {
+        errln!("warning: {w}");
+    }
     let out = a.out.clone().unwrap_or_else(|| a.new.join("compare.md"));
     let png = match write_report(&c, &out) {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            errln!("error: {e}");
+            return 2;
         }
     };
-    println!(
-        "compare: {}: {} of {} points and {} of {} critical speeds changed",
+    outln!(
+        "compare: {}: {} of {} points and {} of {} critical speeds changed{}",
         if c.changed() { "CHANGED" } else { "same" },
         c.points.len(),
         c.points_compared,
         c.critical.len(),
-        c.critical_compared
+        c.critical_compared,
+        if c.spec_differences.is_empty() {
+            ""
+        } else {
+            " (the specs differ)"
+        }
     );
+    for d in &c.spec_differences {
+        outln!("  spec differs     {d}");
+    }
+    for d in &c.not_comparable {
+        outln!("  not comparable   {d}");
+    }
     for p in &c.points {
-        println!("  point {}: {}", p.inputs, p.what.join("; "));
+        outln!("  point {}: {}", p.inputs, p.what.join("; "));
     }
     for k in &c.critical {
-        println!("  critical speed at mu = {}: {}", k.mu, k.what);
+        outln!("  critical speed at mu = {}: {}", k.mu, k.what);
     }
-    println!("  report           {}", out.display());
-    println!("  class map        {}", png.display());
+    outln!("  report           {}", out.display());
+    outln!("  class map        {}", png.display());
     if c.changed() {
-        ExitCode::from(1)
+        1
     } else {
-        ExitCode::SUCCESS
+        0
     }
 }

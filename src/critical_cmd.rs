@@ -125,7 +125,7 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
     }
 
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&rows).expect("results serialise")
         );
@@ -136,7 +136,7 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
 }
 
 fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
-    println!(
+    outln!(
         "whirlmap critical: {}-{} r/min on a {} r/min lattice, bisected to {} r/min, {} s per drop",
         fmt_rpm(a.from),
         fmt_rpm(a.to),
@@ -146,23 +146,23 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
     );
     let class = |c: Option<whirlmap_sweep::classify::OrbitClass>| c.map_or("-", |c| c.name());
     for r in rows {
-        println!();
-        println!("  mu_d = {}", r.mu);
+        outln!();
+        outln!("  mu_d = {}", r.mu);
         match (r.onset_rpm, r.bracket_rpm) {
-            (Some(o), Some([lo, hi])) => println!(
+            (Some(o), Some([lo, hi])) => outln!(
                 "    onset of whirl      {} r/min (bracket {}-{}{})",
                 fmt_rpm(o),
                 fmt_rpm(lo),
                 fmt_rpm(hi),
                 if r.converged { "" } else { ", NOT converged" }
             ),
-            (Some(o), None) => println!(
+            (Some(o), None) => outln!(
                 "    onset of whirl      at or below {} r/min (whirl at the lowest speed)",
                 fmt_rpm(o)
             ),
-            _ => println!("    onset of whirl      none in the range"),
+            _ => outln!("    onset of whirl      none in the range"),
         }
-        println!(
+        outln!(
             "    classes             {} below, {} above",
             class(r.class_below),
             class(r.class_above)
@@ -172,7 +172,7 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
             .iter()
             .map(|[x, y]| format!("{}-{}", fmt_rpm(*x), fmt_rpm(*y)))
             .collect();
-        println!(
+        outln!(
             "    whirl intervals     {}{}",
             if intervals.is_empty() {
                 "none".to_string()
@@ -185,21 +185,22 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                 ""
             }
         );
-        println!(
+        outln!(
             "    non-monotone        {}",
             if r.non_monotone { "YES" } else { "no" }
         );
-        println!(
+        outln!(
             "    drops               {} ({} failed)",
-            r.drops, r.failed_drops
+            r.drops,
+            r.failed_drops
         );
-        println!("    note                {}", r.note);
+        outln!("    note                {}", r.note);
         if let Some(rc) = &r.recheck {
             let show = |o: &whirlmap_sweep::critical::Outcome| match o {
                 whirlmap_sweep::critical::Outcome::Class(c) => c.name().to_string(),
                 whirlmap_sweep::critical::Outcome::Failed(e) => format!("failed ({e})"),
             };
-            println!(
+            outln!(
                 "    recheck ({})   {}: {}, {}: {} -> {}",
                 rc.fidelity,
                 fmt_rpm(rc.lo.0),
@@ -216,6 +217,6 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
     }
     let drops: usize = rows.iter().map(|r| r.drops).sum::<usize>()
         + 2 * rows.iter().filter(|r| r.recheck.is_some()).count();
-    println!();
-    println!("  {drops} drops, {wall_s:.2} s wall");
+    outln!();
+    outln!("  {drops} drops, {wall_s:.2} s wall");
 }

@@ -5,9 +5,9 @@
 //! output folder (nothing run); 4 an output could not be written.
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 use whirlmap_sweep::adaptive::run_adaptive;
 use whirlmap_sweep::ensemble::{self, run_ensemble};
+use whirlmap_sweep::folder::FolderLock;
 use whirlmap_sweep::sweep::SweepError;
 
 /// Arguments of `whirlmap ensemble` and `whirlmap adaptive`.
@@ -30,25 +30,31 @@ pub struct EnsembleArgs {
     compare_full: bool,
 }
 
-fn code(e: &SweepError) -> ExitCode {
-    ExitCode::from(match e {
-        SweepError::Spec(_) | SweepError::ThreadPool(_) => 2,
-        SweepError::Io { .. } => 4,
-    })
+fn code(e: &SweepError) -> u8 {
+    e.exit_code()
 }
 
-fn load(a: &EnsembleArgs) -> Result<(ensemble::EnsembleSpec, PathBuf), ExitCode> {
+/// Reads the file and takes the output folder's lock (one writer at a time; released when the
+/// returned lock is dropped, or the process ends).
+fn load(a: &EnsembleArgs, what: &str) -> Result<(ensemble::EnsembleSpec, PathBuf, FolderLock), u8> {
     match ensemble::load(&a.file) {
         Ok(s) => {
             let out = a
                 .out
                 .clone()
                 .unwrap_or_else(|| PathBuf::from("results").join(&s.name));
-            Ok((s, out))
+            let lock = std::fs::create_dir_all(&out)
+                .map_err(|e| whirlmap_sweep::folder::output_error(&out, e))
+                .and_then(|_| FolderLock::acquire(&out, what))
+                .map_err(|e| {
+                    errln!("error: {e}");
+                    e.exit_code()
+                })?;
+            Ok((s, out, lock))
         }
         Err(e) => {
-            eprintln!("error: {e}");
-            Err(ExitCode::from(2))
+            errln!("error: {e}");
+            Err(2)
         }
     }
 }
@@ -58,21 +64,25 @@ fn fmt_speed(v: Option<f64>) -> String {
 }
 
 /// Runs `whirlmap ensemble`.
-pub fn run_ensemble_cmd(a: &EnsembleArgs) -> ExitCode {
-    let (spec, out) = match load(a) {
+pub fn run_ensemble_cmd(a: &EnsembleArgs) -> u8 {
+    let (spec, out, _lock) = match load(a, "ensemble") {
         Ok(x) => x,
         Err(c) => return c,
     };
     let o = match run_ensemble(&spec, &out, a.threads.map(|n| n as usize), !a.no_progress) {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return code(&e);
         }
     };
-    println!(
+    outln!(
         "ensemble {}: {} cells x {} members = {} drops, {} failed",
-        spec.name, o.cells, o.contours.members, o.drops, o.failed
+        spec.name,
+        o.cells,
+        o.contours.members,
+        o.drops,
+        o.failed
     );
     for g in &o.contours.groups {
         let label = serde_json::to_string(&g.inputs).unwrap_or_default();
@@ -94,25 +104,25 @@ pub fn run_ensemble_cmd(a: &EnsembleArgs) -> ExitCode {
         } else {
             ""
         };
-        println!("  {label}: {} r/min{flag}", levels.join(", "));
+        outln!("  {label}: {} r/min{flag}", levels.join(", "));
     }
     match whirlmap_sweep::prob_chart::render_probability(&out) {
-        Ok(w) => println!("  output           {} ({} charts)", out.display(), w.len()),
+        Ok(w) => outln!("  output           {} ({} charts)", out.display(), w.len()),
         Err(e) => {
-            eprintln!("error: charts: {e}");
-            return ExitCode::from(4);
+            errln!("error: charts: {e}");
+            return 4;
         }
     }
     if o.failed > 0 {
-        ExitCode::from(1)
+        1
     } else {
-        ExitCode::SUCCESS
+        0
     }
 }
 
 /// Runs `whirlmap adaptive`.
-pub fn run_adaptive_cmd(a: &EnsembleArgs) -> ExitCode {
-    let (spec, out) = match load(a) {
+pub fn run_adaptive_cmd(a: &EnsembleArgs) -> u8 {
+    let (spec, out, _lock) = match load(a, "adaptive") {
         Ok(x) => x,
         Err(c) => return c,
     };
@@ -125,11 +135,11 @@ pub fn run_adaptive_cmd(a: &EnsembleArgs) -> ExitCode {
     ) {
         Ok(x) => x,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return code(&e);
         }
     };
-    println!(
+    outln!(
         "adaptive {}: {} of {} drops ({:.1} %) for a {} x {} grid from a {} x {} seed, {} rounds, {} boundary cells",
         r.name,
         r.drops_used,
@@ -144,15 +154,15 @@ pub fn run_adaptive_cmd(a: &EnsembleArgs) -> ExitCode {
     );
     if let Some(c) = &r.comparison {
         let g = &c.agreement;
-        println!(
+        outln!(
             "  against the full grid: boundary within {} fine speed steps, {} columns differ, {} points differ",
             g.max_shift_cells, g.columns_differing, g.points_differing
         );
     }
-    println!("  output           {}", path.display());
+    outln!("  output           {}", path.display());
     if r.evaluated.iter().any(|c| c.p_whirl.is_nan()) {
-        ExitCode::from(1)
+        1
     } else {
-        ExitCode::SUCCESS
+        0
     }
 }

@@ -4,6 +4,9 @@
 //! unsupported chart extension); 3 the simulation failed (a typed solver error); 4 an output
 //! could not be written.
 
+#[macro_use]
+mod output;
+
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -28,7 +31,7 @@ mod sweep_cmd;
 #[derive(Parser)]
 #[command(
     name = "whirlmap",
-    version,
+    version = whirlmap_sweep::build_info::DESCRIPTION,
     about = "Rotor drops onto AMB touchdown bearings: orbits, whirl, design charts"
 )]
 struct Cli {
@@ -55,7 +58,7 @@ enum Command {
     /// settings against a DOP853 reference (CSV, Markdown, log-log charts).
     Accuracy(accuracy_cmd::AccuracyArgs),
     /// Join the shard folders of a sweep into one result (exit 2 if a point is missing or
-    /// twice, or the shards differ in spec or model version; 1 if any point failed).
+    /// twice, or the shards differ in spec, model version or build; 1 if any point failed).
     Merge(merge_cmd::MergeArgs),
     /// Compare two sweep results: class changes, force and power changes beyond thresholds,
     /// critical-speed shifts; a Markdown report with a class map (exit 0 same, 1 changed,
@@ -176,7 +179,7 @@ fn build_scene_with(
         Some(p) => {
             let text = std::fs::read_to_string(p)
                 .with_context(|| format!("cannot read scene file {}", p.display()))?;
-            serde_json::from_str::<Scene>(&text)
+            whirlmap_core::json::from_str::<Scene>(&text)
                 .with_context(|| format!("scene file {}", p.display()))?
         }
         None => Scene::paper(),
@@ -235,17 +238,17 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
         draw_temperatures(path, &title, &th.series).map_err(|e| Failure::Output(e.into()))?;
     }
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&record).expect("records serialise")
         );
     } else {
         print_summary(&scene, &report, &record, wall_s);
         if let Some(p) = &a.orbit {
-            println!("  orbit chart           {}", p.display());
+            outln!("  orbit chart           {}", p.display());
         }
         if let Some(p) = &a.temperatures {
-            println!("  temperature chart     {}", p.display());
+            outln!("  temperature chart     {}", p.display());
         }
     }
     Ok(())
@@ -267,33 +270,35 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
     } else {
         String::new()
     };
-    println!(
+    outln!(
         "whirlmap drop: {:.0} r/min, mu_d {:.3}, {:.4} s simulated ({why}{extended})",
-        scene.speed_rpm, scene.mu_dynamic, r.end_time_s
+        scene.speed_rpm,
+        scene.mu_dynamic,
+        r.end_time_s
     );
-    println!(
+    outln!(
         "  class                 {} ({})",
         rec.class.label(),
         rec.class_reason.describe()
     );
-    println!("  first contact force   {:.1} N", f.first_contact_force_n);
-    println!(
+    outln!("  first contact force   {:.1} N", f.first_contact_force_n);
+    outln!(
         "  max contact force     {:.1} N (at {:.2} ms)",
         f.max_contact_force_n,
         f.max_contact_force_time_s * 1e3
     );
-    println!("  peak friction power   {:.1} W", f.peak_friction_power_w);
-    println!("  peak heat power       {:.1} W", f.peak_heat_power_w);
-    println!(
+    outln!("  peak friction power   {:.1} W", f.peak_friction_power_w);
+    outln!("  peak heat power       {:.1} W", f.peak_heat_power_w);
+    outln!(
         "  whirl frequency       {:+.2} Hz (negative = against the spin)",
         f.whirl_frequency_hz
     );
-    println!(
+    outln!(
         "  contact point turns   {:+.2} since first touch, {:+.2} before settling, {:+.0} consecutive carried at the end",
         f.net_whirl_turns, f.transient_whirl_turns, f.whirl_streak_turns
     );
     let w = &f.window.stats;
-    println!(
+    outln!(
         "  final window          {:.3}-{:.3} s: contact duty {:.3}, mean angle {:+.1} deg from the bottom, range {:.1} deg, {:+.2} turns; {} impacts in all",
         w.start_s,
         w.end_s,
@@ -303,46 +308,48 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
         w.net_turns,
         f.impacts
     );
-    println!(
+    outln!(
         "  final speeds          rotor {:.0} r/min, race {:.0} r/min",
-        f.final_rotor_speed_rpm, f.final_race_speed_rpm
+        f.final_rotor_speed_rpm,
+        f.final_race_speed_rpm
     );
-    println!(
+    outln!(
         "  energy (J)            initial {:.4} = final {:.4} + friction {:.4} + damping {:.6} + drag {:.4}  (residual {:.1e})",
         e.initial_j, e.final_j, e.friction_heat_j, e.damping_loss_j, e.drag_work_j, e.residual_rel
     );
-    println!(
+    outln!(
         "  work                  {} RHS evaluations, {} steps ({} rejected), {} events, {:.3} s wall",
         r.stats.rhs_evals, r.stats.steps, r.stats.rejected, r.stats.events, wall_s
     );
     if let Some(th) = &r.thermal {
         print_thermal(th, r.end_time_s);
     }
-    println!("  scene hash            {}", r.scene_hash);
+    outln!("  scene hash            {}", r.scene_hash);
 }
 
 fn print_thermal(th: &whirlmap_core::ThermalReport, end_time_s: f64) {
     use whirlmap_core::thermal::network::node::NAMES;
-    println!("  temperatures (K)      node: final / peak");
+    outln!("  temperatures (K)      node: final / peak");
     for (name, n) in NAMES.iter().zip(th.temperatures_k.as_array()) {
-        println!("    {name:<20}{:.2} / {:.2}", n.final_k, n.peak_k);
+        outln!("    {name:<20}{:.2} / {:.2}", n.final_k, n.peak_k);
     }
-    println!(
+    outln!(
         "  thermal load F_th     peak {:.2} N, final {:.2} N",
-        th.peak_thermal_load_n, th.final_thermal_load_n
+        th.peak_thermal_load_n,
+        th.final_thermal_load_n
     );
     let h = &th.heat;
-    println!(
+    outln!(
         "  heat (J)              H_s {:.2} + H_i {:.2} + H_o {:.2} = stored {:.2} + lost to ambient {:.2}",
         h.h_s_j, h.h_i_j, h.h_o_j, h.stored_j, h.lost_to_ambient_j
     );
     if let Some(last) = th.series.last() {
-        println!(
+        outln!(
             "  heat power H          {:.1} W at the end (macro-step mean)",
             last.heat_w
         );
     }
-    println!(
+    outln!(
         "  thermal work          {} network steps ({:.0} per simulated second)",
         th.network_steps,
         th.network_steps as f64 / end_time_s.max(1e-12)
@@ -350,11 +357,16 @@ fn print_thermal(th: &whirlmap_core::ThermalReport, end_time_s: f64) {
 }
 
 fn main() -> ExitCode {
+    ExitCode::from(output::finish(run()))
+}
+
+/// Runs the command; returns its exit code.
+fn run() -> u8 {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Drop(a) => run_drop(a),
         Command::Scene => {
-            println!(
+            outln!(
                 "{}",
                 serde_json::to_string_pretty(&Scene::paper()).expect("scene serialises")
             );
@@ -374,10 +386,10 @@ fn main() -> ExitCode {
         Command::Adaptive(a) => return ensemble_cmd::run_adaptive_cmd(a),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => 0,
         Err(f) => {
-            eprintln!("error: {:#}", f.error());
-            ExitCode::from(f.code())
+            errln!("error: {:#}", f.error());
+            f.code()
         }
     }
 }

@@ -2,12 +2,12 @@
 //! `whirlmap_sweep::merge`).
 //!
 //! Exit codes: 0 merged, every point ok; 1 merged, some point failed (recorded as data); 2
-//! refused (a point missing or present twice, shards of different specs, shard counts or
-//! model versions, a folder that is not a shard's) with every problem listed; 4 an output
-//! could not be written.
+//! refused (a point missing or present twice, shards of different specs, shard counts,
+//! model versions or builds, a shard still running or with a file its manifest does not
+//! list, a folder that is not a shard's, an output folder holding another run's results
+//! without --overwrite) with every problem listed; 4 an output could not be written.
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 use whirlmap_sweep::merge::merge;
 
 /// Arguments of `whirlmap merge`.
@@ -19,42 +19,54 @@ pub struct MergeArgs {
     /// Output folder; default: `results/<name>` of the shards' spec.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace the results already in the output folder (they are moved to
+    /// `previous-run/` until the merged records are written). Without it a folder holding
+    /// another run's results is refused.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// Runs the subcommand and returns the process exit code.
-pub fn run(a: &MergeArgs) -> ExitCode {
+pub fn run(a: &MergeArgs) -> u8 {
     let out = match &a.out {
         Some(o) => o.clone(),
         None => match whirlmap_sweep::shard::read_shard_manifest(&a.dirs[0]) {
             Ok(m) => PathBuf::from("results").join(&m.spec.name),
             Err(e) => {
-                eprintln!("error: merge refused:\n  - {e}");
-                return ExitCode::from(2);
+                errln!("error: merge refused:\n  - {e}");
+                return 2;
             }
         },
     };
-    match merge(&a.dirs, &out) {
+    match merge(&a.dirs, &out, a.overwrite) {
         Ok(o) => {
-            println!(
+            for w in &o.warnings {
+                errln!("warning: {w}");
+            }
+            outln!(
                 "merge {}: {} shards, {} points, {} ok, {} failed",
-                o.name, o.shards, o.points, o.ok, o.failed
+                o.name,
+                o.shards,
+                o.points,
+                o.ok,
+                o.failed
             );
             for (class, n) in &o.classes {
-                println!("  {class:<16} {n}");
+                outln!("  {class:<16} {n}");
             }
-            println!("  output           {}", out.display());
+            outln!("  output           {}", out.display());
             if !o.charts.is_empty() {
-                println!("  charts           {} files", o.charts.len());
+                outln!("  charts           {} files", o.charts.len());
             }
             if o.failed > 0 {
-                ExitCode::from(1)
+                1
             } else {
-                ExitCode::SUCCESS
+                0
             }
         }
         Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(e.exit_code())
+            errln!("error: {e}");
+            e.exit_code()
         }
     }
 }

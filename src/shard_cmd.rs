@@ -4,18 +4,17 @@
 
 use crate::sweep_cmd::SweepArgs;
 use std::path::PathBuf;
-use std::process::ExitCode;
 use whirlmap_sweep::shard::{run_shard, Shard};
 use whirlmap_sweep::spec::SweepSpec;
 use whirlmap_sweep::sweep::{ProgressMode, RunOptions};
 
 /// Runs shard `index` of `count` of `spec` with the options of `a`.
-pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> ExitCode {
+pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> u8 {
     let shard = match Shard::new(index, count) {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            errln!("error: {e}");
+            return 2;
         }
     };
     let out_dir = a.out.clone().unwrap_or_else(|| {
@@ -27,6 +26,7 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> ExitC
         out_dir,
         threads: a.threads.map(|n| n as usize),
         resume: a.resume,
+        overwrite: a.overwrite,
         progress: if a.no_progress {
             ProgressMode::Off
         } else {
@@ -36,11 +36,11 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> ExitC
     let (outcome, critical) = match run_shard(spec, &opts, shard) {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(if e.is_input() { 2 } else { 4 });
+            errln!("error: {e}");
+            return e.exit_code();
         }
     };
-    println!(
+    outln!(
         "sweep {} shard {}: {} points, {} ok, {} failed{}",
         spec.name,
         shard.label(),
@@ -54,12 +54,12 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> ExitC
         }
     );
     if let Some(p) = critical {
-        println!("  critical speeds  {}", p.display());
+        outln!("  critical speeds  {}", p.display());
     }
-    println!("  output           {}", opts.out_dir.display());
+    outln!("  output           {}", opts.out_dir.display());
     if outcome.failed > 0 {
-        ExitCode::from(1)
+        1
     } else {
-        ExitCode::SUCCESS
+        0
     }
 }

@@ -1,13 +1,12 @@
 //! `whirlmap sweep FILE`: run a grid of drops from a JSON sweep spec.
 //!
-//! Exit codes: 0 every point ok; 1 some point failed (records still written); 2 bad spec or
-//! unwritable output folder (nothing run); 4 an output (records or charts) could not be
-//! written.
+//! Exit codes: 0 every point ok; 1 some point failed (records still written); 2 bad spec, an
+//! unusable output folder, or one that is in use or holds another run's results (nothing
+//! run); 4 an output (records or charts) could not be written, a full disk included.
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 use whirlmap_sweep::spec;
-use whirlmap_sweep::sweep::{run_sweep, ProgressMode, RunOptions, SweepError};
+use whirlmap_sweep::sweep::{run_sweep, ProgressMode, RunOptions};
 
 /// Arguments of `whirlmap sweep`.
 #[derive(clap::Args)]
@@ -20,9 +19,15 @@ pub struct SweepArgs {
     /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub(crate) threads: Option<u32>,
-    /// Keep the ok points of an existing points.jsonl and run only the rest.
-    #[arg(long)]
+    /// Continue the run in the output folder: keep its ok points and run only the rest. Only
+    /// a run of the same spec (and shard) by the same build is continued.
+    #[arg(long, conflicts_with = "overwrite")]
     pub(crate) resume: bool,
+    /// Replace the results already in the output folder (they are moved to `previous-run/`
+    /// until the new run's first records are written). Without --resume or --overwrite a
+    /// folder holding another run's results is refused.
+    #[arg(long)]
+    pub(crate) overwrite: bool,
     /// No progress bar or progress lines.
     #[arg(long)]
     pub(crate) no_progress: bool,
@@ -37,12 +42,12 @@ pub struct SweepArgs {
 }
 
 /// Runs the subcommand and returns the process exit code.
-pub fn run(a: &SweepArgs) -> ExitCode {
-    let spec = match spec::load(&a.file) {
+pub fn run(a: &SweepArgs) -> u8 {
+    let spec = match spec::read(&a.file) {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            errln!("error: {e}");
+            return 2;
         }
     };
     if let (Some(i), Some(n)) = (a.shard, a.shards) {
@@ -56,23 +61,22 @@ pub fn run(a: &SweepArgs) -> ExitCode {
         out_dir,
         threads: a.threads.map(|n| n as usize),
         resume: a.resume,
+        overwrite: a.overwrite,
         progress: if a.no_progress {
             ProgressMode::Off
         } else {
             ProgressMode::Auto
         },
     };
-    let outcome = match run_sweep(&spec, &opts) {
+    let mut run = match run_sweep(&spec, &opts) {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(match e {
-                SweepError::Spec(_) | SweepError::ThreadPool(_) => 2,
-                SweepError::Io { .. } => 4,
-            });
+            errln!("error: {e}");
+            return e.exit_code();
         }
     };
-    println!(
+    let outcome = run.outcome.clone();
+    outln!(
         "sweep {}: {} points, {} ok, {} failed{}",
         spec.name,
         outcome.points,
@@ -85,39 +89,59 @@ pub fn run(a: &SweepArgs) -> ExitCode {
         }
     );
     for (class, n) in &outcome.classes {
-        println!("  {class:<16} {n}");
+        outln!("  {class:<16} {n}");
     }
-    println!("  output           {}", outcome.out_dir.display());
+    outln!("  output           {}", outcome.out_dir.display());
     let progress = !a.no_progress;
-    match whirlmap_sweep::extras::run_all(&spec, &outcome.out_dir, opts.threads, progress) {
+    let dir = outcome.out_dir.clone();
+    match whirlmap_sweep::extras::run_all(&spec, &dir, opts.threads, progress) {
         Ok(x) => {
-            if let Some(p) = x.critical {
-                println!("  critical speeds  {}", p.display());
+            let mut listed = Vec::new();
+            if let Some(p) = &x.critical {
+                outln!("  critical speeds  {}", p.display());
+                listed.push(p.clone());
+                listed.push(dir.join(whirlmap_sweep::extras::CRITICAL_CSV_FILE));
             }
             if !x.orbits.is_empty() {
-                println!("  orbits           {} drops recorded", x.orbits.len());
+                outln!("  orbits           {} drops recorded", x.orbits.len());
             }
-            if let Some(p) = x.probability {
-                println!("  probability      {}", p.display());
+            listed.push(dir.join("orbits"));
+            if let Some(p) = &x.probability {
+                outln!("  probability      {}", p.display());
+                listed.push(p.clone());
+            }
+            for p in &listed {
+                if let Err(e) = run.record(p) {
+                    errln!("error: {e}");
+                    return e.exit_code();
+                }
             }
         }
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(4);
+            errln!("error: {e}");
+            return 4;
         }
     }
     if !spec.charts.is_empty() {
-        match whirlmap_sweep::charts::render_all(&outcome.out_dir) {
-            Ok(written) => println!("  charts           {} files", written.len()),
+        match whirlmap_sweep::charts::render_all(&dir) {
+            Ok(written) => outln!("  charts           {} files", written.len()),
             Err(e) => {
-                eprintln!("error: charts: {e}");
-                return ExitCode::from(4);
+                errln!("error: charts: {e}");
+                return 4;
             }
         }
+        if let Err(e) = run.record(&dir.join("charts")) {
+            errln!("error: {e}");
+            return e.exit_code();
+        }
+    }
+    if let Err(e) = run.finish() {
+        errln!("error: {e}");
+        return e.exit_code();
     }
     if outcome.failed > 0 {
-        ExitCode::from(1)
+        1
     } else {
-        ExitCode::SUCCESS
+        0
     }
 }

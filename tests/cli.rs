@@ -125,7 +125,7 @@ fn bad_input_exits_2_naming_field_value_and_range() {
         (&["--duration-s", "-1"], &["duration_s", "-1"]),
         (
             &["--set", "rotor_mass_kg=0"],
-            &["rotor_mass_kg", "0", "> 0"],
+            &["rotor_mass_kg", "0", "[1e-3, 1e6] kg"],
         ),
         (&["--set", "race_mass_kg=-1"], &["race_mass_kg", "-1"]),
         (&["--set", "clearance_m=0"], &["clearance_m", "(0, 0.1]"]),

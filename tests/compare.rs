@@ -69,9 +69,15 @@ fn compare_exit_codes_thresholds_and_report() {
     assert!(out(&o).contains("max force"), "{}", out(&o));
 
     // A class change and a critical speed whose brackets no longer overlap (files edited as
-    // a regression would change them): changed (exit 1), both named in the report.
+    // a regression would change them): changed (exit 1), both named in the report. Edited
+    // files are no run's record, so they go into folders without a manifest (compare warns
+    // that it cannot check them); a run's own folder refuses them.
     let new = dir.join("edited");
     std::fs::create_dir_all(&new).unwrap();
+    let run_base = base;
+    let base = dir.join("edited-base");
+    std::fs::create_dir_all(&base).unwrap();
+    std::fs::copy(run_base.join("points.jsonl"), base.join("points.jsonl")).unwrap();
     let text = std::fs::read_to_string(again.join("points.jsonl")).unwrap();
     let first = text.lines().next().unwrap();
     let v: serde_json::Value = serde_json::from_str(first).unwrap();
@@ -109,9 +115,37 @@ fn compare_exit_codes_thresholds_and_report() {
     };
     std::fs::write(base.join("critical.json"), critical(4000.0, 4500.0)).unwrap();
     std::fs::write(new.join("critical.json"), critical(4400.0, 4900.0)).unwrap();
+    let o = whirlmap(&[
+        "compare",
+        s(&run_base),
+        s(&new),
+        "--out",
+        s(&dir.join("x.md")),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    std::fs::write(run_base.join("critical.json"), critical(4000.0, 4500.0)).unwrap();
+    let o = whirlmap(&[
+        "compare",
+        s(&run_base),
+        s(&new),
+        "--out",
+        s(&dir.join("x.md")),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "a file the run did not write: {}",
+        out(&o)
+    );
+    assert!(stderr(&o).contains("critical.json"), "{}", stderr(&o));
     let report = dir.join("overlap.md");
     let o = whirlmap(&["compare", s(&base), s(&new), "--out", s(&report)]);
     assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    assert!(
+        stderr(&o).contains("warning") && stderr(&o).contains("no manifest.json"),
+        "{}",
+        stderr(&o)
+    );
     let md = std::fs::read_to_string(&report).unwrap();
     assert!(
         md.contains("1 of 4 points and 0 of 2 critical speeds"),

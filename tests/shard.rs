@@ -116,8 +116,12 @@ fn assert_same_result(single: &Path, merged: &Path) {
     assert_eq!(names, files(merged), "the same files");
     for n in &names {
         let name = n.to_str().unwrap();
-        // Run facts (wall times, threads) differ; the ensemble's manifest is one of them.
-        if name == "manifest.json" || name == "timings.jsonl" || name == "probability/manifest.json"
+        // Run facts (wall times, threads) differ; the ensemble's manifest is one of them. The
+        // lock file names the process that last held it.
+        if name == "manifest.json"
+            || name == "timings.jsonl"
+            || name == "probability/manifest.json"
+            || name == ".whirlmap.lock"
         {
             continue;
         }
@@ -138,6 +142,11 @@ fn assert_same_result(single: &Path, merged: &Path) {
             m.remove(k);
         }
         m["counts"].as_object_mut().unwrap().remove("skipped");
+        // Every file is listed; those holding run facts with their own sizes and hashes.
+        let files = m["files"].as_object_mut().unwrap();
+        for f in ["timings.jsonl", "probability/manifest.json"] {
+            assert!(files.remove(f).is_some(), "{f} not listed");
+        }
         v
     };
     let (a, b) = (

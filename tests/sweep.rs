@@ -115,7 +115,7 @@ fn bad_specs_exit_2_name_the_field_and_run_nothing() {
 fn points_are_byte_identical_for_any_thread_count() {
     let dir = temp_dir("threads");
     let (a, b) = (dir.join("t1"), dir.join("t2"));
-    // Without --resume an existing points.jsonl is replaced.
+    // With --overwrite an existing points.jsonl is replaced.
     std::fs::create_dir_all(&a).unwrap();
     std::fs::write(a.join("points.jsonl"), "stale\n").unwrap();
     for (out, threads) in [(&a, "1"), (&b, "2")] {
@@ -127,6 +127,7 @@ fn points_are_byte_identical_for_any_thread_count() {
             "--threads",
             threads,
             "--no-progress",
+            "--overwrite",
         ]);
         assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
         assert!(

@@ -51,3 +51,39 @@ pub fn out(o: &Output) -> String {
         String::from_utf8_lossy(&o.stderr)
     )
 }
+
+/// Runs `whirlmap` with `args`, killing it after `limit` (a hang or a runaway allocation
+/// fails the test instead of stalling it). `None` when it had to be killed.
+pub fn whirlmap_within<S: AsRef<OsStr>>(args: &[S], limit: std::time::Duration) -> Option<Output> {
+    use std::process::Stdio;
+    let mut child = Command::new(BIN)
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs the binary");
+    let start = std::time::Instant::now();
+    loop {
+        if child.try_wait().expect("waits").is_some() {
+            return Some(child.wait_with_output().expect("collects the output"));
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
+/// Writes a sweep spec `text` to `dir/<name>.json` and returns its path.
+pub fn spec_file(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(format!("{name}.json"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A file's JSON.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}

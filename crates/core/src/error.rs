@@ -58,6 +58,29 @@ pub enum SolveError {
         /// Events located so far.
         events: u64,
     },
+    /// The energy audit did not close: the energy at the end plus the heat and work booked
+    /// along the way differ from the energy at release by more than the threshold
+    /// ([`crate::drop::AUDIT_THRESHOLD`]), relative to the largest energy in play (or an
+    /// energy was not finite). The results of such a drop are not trustworthy.
+    #[error(
+        "energy audit failed at t = {t_s:.9} s: residual {residual_rel:.3e} above the \
+         threshold {threshold:.0e} (initial {initial_j:.6e} J = final {final_j:.6e} J + \
+         losses {losses_j:.6e} J)"
+    )]
+    EnergyAudit {
+        /// Simulated time at the end of the drop (s).
+        t_s: f64,
+        /// The audit's relative residual (infinite when an energy was not finite).
+        residual_rel: f64,
+        /// The threshold it exceeded.
+        threshold: f64,
+        /// Mechanical energy at release (J).
+        initial_j: f64,
+        /// Mechanical energy at the end (J).
+        final_j: f64,
+        /// Friction heat, damping loss and drag work (J).
+        losses_j: f64,
+    },
     /// The scene failed validation.
     #[error(transparent)]
     Invalid(#[from] InvalidParameter),
@@ -71,6 +94,7 @@ impl SolveError {
             SolveError::StepBudget { .. } => "step_budget",
             SolveError::NonFiniteState { .. } => "non_finite_state",
             SolveError::EventBudget { .. } => "event_budget",
+            SolveError::EnergyAudit { .. } => "energy_audit",
             SolveError::Invalid(_) => "invalid_parameter",
         }
     }

@@ -66,6 +66,7 @@ pub mod classify;
 pub mod drop;
 pub mod error;
 pub mod fidelity;
+pub mod json;
 pub mod model;
 pub mod monitor;
 pub mod ode;

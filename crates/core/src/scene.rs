@@ -143,9 +143,11 @@ pub struct Scene {
     pub gravity_m_s2: f64,
 
     // ---- rotor (Table 2) -------------------------------------------------------------
-    /// Whole rotor mass (kg). Table 2: 11.5. Allowed > 0.
+    /// Whole rotor mass (kg). Table 2: 11.5. Allowed [1e-3, 1e6].
     pub rotor_mass_kg: f64,
     /// Whole rotor polar moment of inertia about its mass centre (kg m^2). Table 2: 5.806e-3.
+    /// Allowed: a radius of gyration sqrt(J / m) within [0.01, 100] journal radii
+    /// ([`Scene::validate_consistency`]).
     pub rotor_polar_moi_kg_m2: f64,
     /// Share of the rotor carried by this touchdown location (MODEL-NOTES: two locations,
     /// one at each end, so 0.5). Mass and inertia in the equations are scaled by it.
@@ -178,27 +180,32 @@ pub struct Scene {
     pub race_speed_rad_s: f64,
 
     // ---- inner race (Tables 2, 4) ------------------------------------------------------
-    /// Inner race mass (kg). Table 2: 0.048.
+    /// Inner race mass (kg). Table 2: 0.048. Allowed [1e-5, 1e6].
     pub race_mass_kg: f64,
-    /// Inner race polar moment of inertia (kg m^2). Table 2: 2.33e-5.
+    /// Inner race polar moment of inertia (kg m^2). Table 2: 2.33e-5. Allowed: a radius of
+    /// gyration within [0.01, 100] race bore radii.
     pub race_polar_moi_kg_m2: f64,
     /// Radial clearance between rotor and race bore, s (m). Table 4: 0.15 mm. The race bore
     /// radius is `rotor_diameter_m / 2 + clearance_m` (MODEL-NOTES). Allowed (0, 0.1].
     pub clearance_m: f64,
 
     // ---- contacts (Table 4, eq. 7) ------------------------------------------------------
-    /// Rotor-race Hertz stiffness k1 (N/m^e). Table 4: 1.988e9 N m^-10/9.
+    /// Rotor-race Hertz stiffness k1 (N/m^e). Table 4: 1.988e9 N m^-10/9. Allowed: a force
+    /// at 1 um penetration, k1 (1e-6 m)^e, in [1e-2, 1e10] N (Table 4's: 428 N), which also
+    /// catches a stiffness kept when the exponent changes ([`Scene::validate_consistency`]).
     pub contact_stiffness_n_per_m_e: f64,
     /// Rotor-race Hertz exponent e of eq. 7. Line contact: 10/9. Allowed [1, 2].
     pub contact_exponent: f64,
-    /// Rotor-race contact damping c1 (N s/m). Table 4: 1000. Allowed >= 0.
+    /// Rotor-race contact damping c1 (N s/m). Table 4: 1000. Allowed [0, 1e8].
     pub contact_damping_n_s_per_m: f64,
     /// Race-on-balls lumped radial stiffness k2 (N/m^e). Table 4: 2.47e5 N/mm^1.5 =
     /// 7.811e9 N/m^1.5 (converted here). Zero internal clearance, isotropic (MODEL-NOTES).
+    /// Allowed: a force at 1 um penetration, k2 (1e-6 m)^e, in [1e-3, 1e10] N (Table 4's:
+    /// 7.8 N; 2.47e5 read as N/m^1.5 gives 2.5e-4 N and is refused).
     pub support_stiffness_n_per_m_e: f64,
     /// Race-on-balls Hertz exponent. Point contact: 3/2. Allowed [1, 2].
     pub support_exponent: f64,
-    /// Race-on-balls damping c2 (N s/m). Table 4: 750. Allowed >= 0.
+    /// Race-on-balls damping c2 (N s/m). Table 4: 750. Allowed [0, 1e8].
     pub support_damping_n_s_per_m: f64,
     /// How the support damper c2 acts on the race ([`SupportDamper`]). Default
     /// `isotropic` (from `MODEL_VERSION` 3): a ball set damps the race in every direction.
@@ -214,10 +221,11 @@ pub struct Scene {
     pub palmgren_f0: f64,
     /// Lubricant kinematic viscosity nu0 (mm^2/s = cSt). Default 22. Allowed [0, 10000].
     pub lubricant_viscosity_mm2_s: f64,
-    /// Bearing pitch diameter d_m (m). Default (40 + 62)/2 mm = 51 mm (Table 3).
+    /// Bearing pitch diameter d_m (m). Default (40 + 62)/2 mm = 51 mm (Table 3). Allowed:
+    /// larger than the race bore diameter `rotor_diameter_m + 2 clearance_m`, at most 10 m.
     pub pitch_diameter_m: f64,
     /// Basic static load rating C0 of the bearing (N) in f1 = 0.001 (P0/C0)^0.33. Default
-    /// 10 000 N, the order of a 71908 catalogue entry (MODEL-NOTES). Allowed > 0.
+    /// 10 000 N, the order of a 71908 catalogue entry (MODEL-NOTES). Allowed [1, 1e8].
     pub static_load_rating_n: f64,
     /// Race speed below which the drag torque is scaled by tanh(omega / this) so it has a
     /// defined, chatter-free value at zero speed (rad/s). Default 0.1 (about 1 r/min).
@@ -260,6 +268,52 @@ pub struct Scene {
 impl Default for Scene {
     fn default() -> Self {
         Self::paper()
+    }
+}
+
+/// Allowed rotor mass (kg): a gram to a thousand tonnes (beyond any rotor, but the
+/// physics tests model a rigid wall as a 1e6 kg race).
+pub const MASS_RANGE_KG: [f64; 2] = [1e-3, 1e6];
+/// Allowed inner race mass (kg).
+pub const RACE_MASS_RANGE_KG: [f64; 2] = [1e-5, 1e6];
+/// Allowed radius of gyration of each body, as multiples of its radius at the contact (see
+/// [`Scene::validate_consistency`]).
+pub const GYRATION_RANGE: [f64; 2] = [0.01, 100.0];
+/// Allowed rotor-race contact force at 1 um penetration, k1 (1e-6 m)^e1 (N).
+pub const CONTACT_FORCE_AT_1UM_N: [f64; 2] = [1e-2, 1e10];
+/// Allowed race-on-balls support force at 1 um penetration, k2 (1e-6 m)^e2 (N).
+pub const SUPPORT_FORCE_AT_1UM_N: [f64; 2] = [1e-3, 1e10];
+/// Largest contact or support damping coefficient (N s/m): 1e5 times Table 4's.
+pub const MAX_DAMPING_N_S_PER_M: f64 = 1e8;
+
+/// A number as a person would write it in a message: `1e308` and `1e-300` rather than 309
+/// digits, `0.15` as is.
+pub fn num(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && a.is_finite() && !(1e-4..1e7).contains(&a) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
+/// A derived number for a message, to three significant digits (`45.3`, `4.53e-7`): the
+/// bounds and values a check computes, as opposed to [`num`]'s exact echo of an input.
+fn approx(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !a.is_finite() {
+        return v.to_string();
+    }
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+        let text = format!("{v:.decimals$}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        format!("{v:.2e}")
     }
 }
 
@@ -352,11 +406,10 @@ impl Scene {
             if v.is_finite() && ok {
                 Ok(())
             } else {
-                Err(InvalidParameter::new(field, v, allowed))
+                Err(InvalidParameter::new(field, num(v), allowed))
             }
         }
         let pos = "> 0 and finite";
-        let nonneg = ">= 0 and finite";
         check(
             "speed_rpm",
             self.speed_rpm,
@@ -394,8 +447,8 @@ impl Scene {
         check(
             "rotor_mass_kg",
             self.rotor_mass_kg,
-            self.rotor_mass_kg > 0.0,
-            pos,
+            (MASS_RANGE_KG[0]..=MASS_RANGE_KG[1]).contains(&self.rotor_mass_kg),
+            "[1e-3, 1e6] kg",
         )?;
         check(
             "rotor_polar_moi_kg_m2",
@@ -458,8 +511,8 @@ impl Scene {
         check(
             "race_mass_kg",
             self.race_mass_kg,
-            self.race_mass_kg > 0.0,
-            pos,
+            (RACE_MASS_RANGE_KG[0]..=RACE_MASS_RANGE_KG[1]).contains(&self.race_mass_kg),
+            "[1e-5, 1e6] kg",
         )?;
         check(
             "race_polar_moi_kg_m2",
@@ -482,8 +535,8 @@ impl Scene {
         check(
             "contact_damping_n_s_per_m",
             self.contact_damping_n_s_per_m,
-            self.contact_damping_n_s_per_m >= 0.0,
-            nonneg,
+            (0.0..=MAX_DAMPING_N_S_PER_M).contains(&self.contact_damping_n_s_per_m),
+            "[0, 1e8] N s/m",
         )?;
         check(
             "support_stiffness_n_per_m_e",
@@ -500,8 +553,8 @@ impl Scene {
         check(
             "support_damping_n_s_per_m",
             self.support_damping_n_s_per_m,
-            self.support_damping_n_s_per_m >= 0.0,
-            nonneg,
+            (0.0..=MAX_DAMPING_N_S_PER_M).contains(&self.support_damping_n_s_per_m),
+            "[0, 1e8] N s/m",
         )?;
         check(
             "palmgren_f0",
@@ -524,8 +577,8 @@ impl Scene {
         check(
             "static_load_rating_n",
             self.static_load_rating_n,
-            self.static_load_rating_n > 0.0,
-            pos,
+            (1.0..=1e8).contains(&self.static_load_rating_n),
+            "[1, 1e8] N",
         )?;
         check(
             "drag_zero_speed_rad_s",
@@ -585,8 +638,112 @@ impl Scene {
                 "[0, 1e6] r/min",
             )?;
         }
+        self.validate_consistency()?;
         if let Some(t) = &self.thermal {
             t.validate_with(self.race_bore_radius_m(), self.pitch_diameter_m)?;
+        }
+        Ok(())
+    }
+
+    /// Physical consistency between fields, each in range on its own (called by
+    /// [`Scene::validate`] after the per-field checks):
+    /// - the bearing's pitch diameter lies outside the race bore (`pitch_diameter_m` >
+    ///   2 x the race bore radius);
+    /// - each body's radius of gyration sqrt(J / m) is between 0.01 and 100 times the radius
+    ///   at the touchdown contact (the journal radius for the rotor, the race bore radius for
+    ///   the race): Table 2's rotor has 1.13, its race 1.10; a moment of inertia in the wrong
+    ///   unit (g cm^2, or per unit length) lands far outside;
+    /// - each Hertz stiffness, in N/m^e for its exponent e, gives a force at 1 um of
+    ///   penetration, k (1e-6 m)^e, of at least 1e-2 N for the rotor-race contact (Table 4's
+    ///   k1 = 1.988e9 N/m^(10/9) gives 428 N) and 1e-3 N for the race on its balls
+    ///   (k2 = 7.811e9 N/m^1.5 gives 7.8 N), and at most 1e10 N (a rigid wall, as the physics
+    ///   tests model one). The unit of k depends on e: k2 = 2.47e5 N/mm^1.5 read as N/m^1.5
+    ///   gives 2.5e-4 N and is refused, as is a stiffness kept when its exponent is changed
+    ///   (k1 with e = 2 gives 2e-3 N). (k1 in N/mm^(10/9), 2154 times too small, gives 0.2 N:
+    ///   inside the range, which must hold the extremes matrix's k x 1e-3, 0.43 N.)
+    pub fn validate_consistency(&self) -> Result<(), InvalidParameter> {
+        let bore_d = 2.0 * self.race_bore_radius_m();
+        if !(self.pitch_diameter_m > bore_d) {
+            return Err(InvalidParameter::new(
+                "pitch_diameter_m",
+                num(self.pitch_diameter_m),
+                &format!(
+                    "> the race bore diameter rotor_diameter_m + 2 clearance_m = {} m (the \
+                     bearing's balls run outside its bore)",
+                    approx(bore_d)
+                ),
+            ));
+        }
+        for (field, moi, mass, mass_field, radius, what) in [
+            (
+                "rotor_polar_moi_kg_m2",
+                self.rotor_polar_moi_kg_m2,
+                self.rotor_mass_kg,
+                "rotor_mass_kg",
+                self.rotor_radius_m(),
+                "the journal radius rotor_diameter_m / 2",
+            ),
+            (
+                "race_polar_moi_kg_m2",
+                self.race_polar_moi_kg_m2,
+                self.race_mass_kg,
+                "race_mass_kg",
+                self.race_bore_radius_m(),
+                "the race bore radius",
+            ),
+        ] {
+            let gyration = (moi / mass).sqrt();
+            let [lo, hi] = GYRATION_RANGE;
+            if !(gyration >= lo * radius && gyration <= hi * radius) {
+                return Err(InvalidParameter::new(
+                    field,
+                    num(moi),
+                    &format!(
+                        "a radius of gyration sqrt({field} / {mass_field}) within [{lo}, {hi}] \
+                         x {what} ({} m), i.e. [{}, {}] kg m^2 with {mass_field} = {}; here {} m",
+                        approx(radius),
+                        approx(mass * (lo * radius).powi(2)),
+                        approx(mass * (hi * radius).powi(2)),
+                        num(mass),
+                        approx(gyration)
+                    ),
+                ));
+            }
+        }
+        for (field, k, e, exp_field, [lo, hi], table) in [
+            (
+                "contact_stiffness_n_per_m_e",
+                self.contact_stiffness_n_per_m_e,
+                self.contact_exponent,
+                "contact_exponent",
+                CONTACT_FORCE_AT_1UM_N,
+                "Table 4's k1 = 1.988e9 N/m^(10/9) gives 428 N",
+            ),
+            (
+                "support_stiffness_n_per_m_e",
+                self.support_stiffness_n_per_m_e,
+                self.support_exponent,
+                "support_exponent",
+                SUPPORT_FORCE_AT_1UM_N,
+                "Table 4's k2 = 7.811e9 N/m^1.5 = 2.47e5 N/mm^1.5 gives 7.8 N",
+            ),
+        ] {
+            let f = k * 1e-6_f64.powf(e);
+            if !(f >= lo && f <= hi) {
+                return Err(InvalidParameter::new(
+                    field,
+                    num(k),
+                    &format!(
+                        "a stiffness in N/m^e ({exp_field} e = {}) whose force at 1 um \
+                         penetration, k (1e-6 m)^e, is in [{}, {}] N ({table}); here {} N. A \
+                         stiffness in N/mm^e is 1000^e times too small",
+                        approx(e),
+                        num(lo),
+                        num(hi),
+                        approx(f)
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -655,6 +812,18 @@ mod tests {
         assert_ne!(a.hash_hex(), b.hash_hex());
         // Pinned: a change here means every stored record key changes; bump MODEL_VERSION.
         assert_eq!(a.hash_hex().len(), 16);
+    }
+
+    #[test]
+    fn derived_numbers_in_messages_have_three_digits() {
+        assert_eq!(approx(45.312587499999), "45.3");
+        assert_eq!(approx(0.0123456), "0.0123");
+        assert_eq!(approx(0.04), "0.04");
+        assert_eq!(approx(2.0), "2");
+        assert_eq!(approx(10.0 / 9.0), "1.11");
+        assert_eq!(approx(4.53125875e-7), "4.53e-7");
+        assert_eq!(num(1e308), "1e308");
+        assert_eq!(num(0.15), "0.15");
     }
 
     #[test]

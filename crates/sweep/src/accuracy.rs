@@ -137,7 +137,7 @@ impl AccuracySpec {
             path: p.clone(),
             source,
         })?;
-        let spec: Self = serde_json::from_str(&text)
+        let spec: Self = whirlmap_core::json::from_str(&text)
             .map_err(|source| AccuracySpecError::Parse { path: p, source })?;
         spec.validate()?;
         Ok(spec)

@@ -536,11 +536,11 @@ pub fn run_adaptive(
         let v = pool.install(|| evaluate_points(spec, &batch));
         done += pts.len();
         if show_progress {
-            eprintln!(
+            crate::sweep::progress_line(&format!(
                 "adaptive {}: {done} corners evaluated, {:.0} s",
                 spec.name,
                 start.elapsed().as_secs_f64()
-            );
+            ));
         }
         v
     };
@@ -614,10 +614,7 @@ pub fn run_adaptive(
     };
     let path = out_dir.join(ADAPTIVE_FILE);
     let text = serde_json::to_string_pretty(&report).expect("report serialises");
-    std::fs::write(&path, format!("{text}\n")).map_err(|source| SweepError::Io {
-        path: path.clone(),
-        source,
-    })?;
+    crate::folder::write_atomic(&path, format!("{text}\n").as_bytes())?;
     Ok((report, path))
 }
 

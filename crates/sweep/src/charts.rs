@@ -125,6 +125,8 @@ pub struct PointRow {
     pub peak_temperature_k: Option<f64>,
     /// The error of a failed point, as text.
     pub error: Option<String>,
+    /// Simulated time asked for (s), when the record says.
+    pub duration_s: Option<f64>,
 }
 
 impl PointRow {
@@ -158,6 +160,8 @@ struct RawRow {
     record: Option<Value>,
     #[serde(default)]
     error: Option<Value>,
+    #[serde(default)]
+    duration_s: Option<f64>,
 }
 
 fn finite(v: Option<&Value>) -> Option<f64> {
@@ -200,12 +204,14 @@ impl From<RawRow> for PointRow {
                         .reduce(f64::max)
                 }),
             error,
+            duration_s: r.duration_s,
         }
     }
 }
 
-/// Reads `dir/points.jsonl`. Blank lines are ignored and an unparseable last line (a write
-/// torn by a crash) is skipped; an unparseable line elsewhere is an error.
+/// Reads `dir/points.jsonl`. Blank lines are ignored and an unparseable last line after at
+/// least one record (a write torn by a crash) is skipped; an unparseable line elsewhere, or a
+/// file whose only line is not a record, is an error.
 pub fn load_points(dir: &Path) -> Result<Vec<PointRow>, ChartError> {
     let path = dir.join("points.jsonl");
     let bytes = match std::fs::read(&path) {
@@ -225,12 +231,13 @@ pub fn load_points(dir: &Path) -> Result<Vec<PointRow>, ChartError> {
     for (k, (n, line)) in lines.iter().enumerate() {
         match serde_json::from_str::<RawRow>(line) {
             Ok(raw) => rows.push(PointRow::from(raw)),
-            Err(_) if k + 1 == lines.len() => {} // torn last line
+            // A torn last line after real records.
+            Err(_) if k + 1 == lines.len() && k > 0 => {}
             Err(e) => {
                 return Err(ChartError::Parse {
                     path,
                     line: n + 1,
-                    message: e.to_string(),
+                    message: format!("not a record of a grid point: {e}"),
                 })
             }
         }
@@ -1351,7 +1358,29 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         )?;
     }
     written.extend(prob);
+    remove_stale_charts(&out_dir, &written)?;
     Ok(written)
+}
+
+/// Removes the charts in `dir` that this rendering did not draw (a Fig. 4 left from an
+/// earlier spec with a critical search, say), so `charts/` shows only what the data holds.
+fn remove_stale_charts(dir: &Path, written: &[PathBuf]) -> Result<(), ChartError> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        let chart = p
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("png") || x.eq_ignore_ascii_case("svg"));
+        if chart && p.is_file() && !written.iter().any(|w| w == &p) {
+            std::fs::remove_file(&p).map_err(|cause| ChartError::Write {
+                path: p.clone(),
+                cause,
+            })?;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -1442,6 +1471,7 @@ mod tests {
             peak_heat_power_w: None,
             peak_temperature_k: None,
             error: None,
+            duration_s: None,
         };
         let rows = vec![
             row(3, 1000.0, 0.1, 2e-4),

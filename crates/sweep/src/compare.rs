@@ -10,6 +10,13 @@
 //!   and not in the other is a change as well. Overlapping brackets are "the same": the search
 //!   cannot tell the speeds apart.
 //!
+//! - Only like with like: a point is comparable when both runs have it (the same inputs) with
+//!   the same simulated duration; the specs' differences (from the manifests: `duration_s`,
+//!   the scene, the axes, ...) are always stated, and when no point is comparable the
+//!   comparison is refused rather than reported as the same. Each folder is checked first
+//!   ([`crate::folder::check_inputs`]): a file its run did not write is refused, a folder
+//!   being written is refused, a run that did not finish is said loudly.
+//!
 //! [`compare`] returns the findings; [`write_report`] writes them as Markdown with a class map
 //! of the new run whose changed cells are outlined.
 
@@ -102,6 +109,14 @@ pub struct Comparison {
     pub critical: Vec<CriticalChange>,
     /// Both runs' manifests' `spec.name`, `model_version` (for the report header).
     pub runs: [RunInfo; 2],
+    /// What differs between the two specs (`duration_s: 1.0 -> 0.5`, ...), the name and the
+    /// chart list aside; empty when they are the same or a manifest is missing.
+    pub spec_differences: Vec<String>,
+    /// Points in both runs that cannot be compared (a different duration), with why.
+    pub not_comparable: Vec<String>,
+    /// What could not be checked or is partial (a folder without a manifest, a run that did
+    /// not finish), to be said loudly.
+    pub warnings: Vec<String>,
     /// The new run's rows (for the class map).
     new_rows: Vec<PointRow>,
 }
@@ -122,6 +137,20 @@ pub struct RunInfo {
     pub model_version: String,
     /// The git commit, if recorded.
     pub git_commit: String,
+    /// The spec hash, if recorded.
+    pub spec_hash: String,
+}
+
+/// Why two results cannot be compared.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    /// A folder's points or critical speeds could not be read.
+    #[error(transparent)]
+    Read(#[from] ChartError),
+    /// The folders cannot be compared: nothing comparable, a folder being written, a file
+    /// its run did not write. Every reason, one per entry.
+    #[error("compare refused:\n  - {}", .0.join("\n  - "))]
+    Refused(Vec<String>),
 }
 
 fn run_info(dir: &Path) -> RunInfo {
@@ -138,6 +167,7 @@ fn run_info(dir: &Path) -> RunInfo {
         name: text(m.get("spec").and_then(|s| s.get("name"))),
         model_version: text(m.get("model_version")),
         git_commit: text(m.get("git_commit")),
+        spec_hash: text(m.get("spec_hash")),
     }
 }
 
@@ -268,9 +298,49 @@ fn compare_critical(base: &[CriticalRow], new: &[CriticalRow]) -> (usize, Vec<Cr
     (compared, changes)
 }
 
+/// Checks a folder before it is compared: not being written, and every file it holds is its
+/// run's ([`crate::folder::check_inputs`]). Returns its warnings.
+fn check_folder(dir: &Path) -> Result<Vec<String>, Vec<String>> {
+    if let Some(who) = crate::folder::running_writer(dir) {
+        return Err(vec![format!(
+            "{} is being written by a running whirlmap ({who}): compare it when that run has \
+             finished",
+            dir.display()
+        )]);
+    }
+    crate::folder::check_inputs(dir, &crate::folder::reader_inputs(dir)).map(|c| c.warnings)
+}
+
+/// The differences between the specs of two folders' manifests, the name and the charts
+/// aside (they change no record).
+fn specs_differ(baseline: &Path, new: &Path) -> Vec<String> {
+    let (Some(a), Some(b)) = (
+        crate::folder::manifest_spec(baseline),
+        crate::folder::manifest_spec(new),
+    ) else {
+        return Vec::new();
+    };
+    crate::folder::spec_differences(&a, &b)
+        .into_iter()
+        .filter(|d| !d.starts_with("name:") && !d.starts_with("charts"))
+        .collect()
+}
+
 /// Compares the result folders `baseline` and `new` (each with `points.jsonl`, optionally
 /// `critical.json` and `manifest.json`).
-pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison, ChartError> {
+pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison, CompareError> {
+    let mut warnings = Vec::new();
+    let mut refused = Vec::new();
+    for dir in [baseline, new] {
+        match check_folder(dir) {
+            Ok(w) => warnings.extend(w),
+            Err(p) => refused.extend(p),
+        }
+    }
+    if !refused.is_empty() {
+        return Err(CompareError::Refused(refused));
+    }
+    let spec_differences = specs_differ(baseline, new);
     let base_rows = load_points(baseline)?;
     let new_rows = load_points(new)?;
     let mut base_by: BTreeMap<String, &PointRow> = BTreeMap::new();
@@ -283,6 +353,7 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
     }
     let mut points = Vec::new();
     let mut compared = 0;
+    let mut not_comparable = Vec::new();
     let mut seen = std::collections::BTreeSet::new();
     for r in &new_rows {
         let key = inputs_key(r);
@@ -293,6 +364,16 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
         let mut what = Vec::new();
         match base_by.get(&key) {
             None => what.push("not in the baseline".to_string()),
+            Some(b) if b.duration_s != n.duration_s => {
+                let d = |v: Option<f64>| v.map_or("?".to_string(), |x| format!("{x} s"));
+                not_comparable.push(format!(
+                    "{}: simulated for {} in the baseline, {} in the new run",
+                    inputs_text(n),
+                    d(b.duration_s),
+                    d(n.duration_s)
+                ));
+                continue;
+            }
             Some(b) => {
                 compared += 1;
                 let (bc, nc) = (class_name(b), class_name(n));
@@ -332,9 +413,41 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
             });
         }
     }
+    if compared == 0 {
+        let mut why = vec![format!(
+            "nothing to compare: no grid point of {} is in {} with the same inputs and \
+             duration ({} and {} points read)",
+            new.display(),
+            baseline.display(),
+            new_rows.len(),
+            base_rows.len()
+        )];
+        if !spec_differences.is_empty() {
+            why.push(format!("the specs differ: {}", spec_differences.join("; ")));
+        }
+        why.extend(not_comparable.iter().take(3).cloned());
+        return Err(CompareError::Refused(why));
+    }
     let (critical_compared, critical) = match (load_critical(baseline)?, load_critical(new)?) {
         (None, None) => (0, Vec::new()),
-        (b, n) => compare_critical(&b.unwrap_or_default(), &n.unwrap_or_default()),
+        (b, n) => {
+            // Searches with other drop durations are other experiments.
+            let (b, n) = (b.unwrap_or_default(), n.unwrap_or_default());
+            let same = |r: &CriticalRow, other: &[CriticalRow]| {
+                other
+                    .iter()
+                    .all(|o| (o.mu - r.mu).abs() > 1e-12 || o.duration_s == r.duration_s)
+            };
+            let b2: Vec<CriticalRow> = b.iter().filter(|r| same(r, &n)).cloned().collect();
+            let n2: Vec<CriticalRow> = n.iter().filter(|r| same(r, &b)).cloned().collect();
+            for r in n.iter().filter(|r| !same(r, &b)) {
+                not_comparable.push(format!(
+                    "critical speed at mu = {}: searched with drops of another duration",
+                    r.mu
+                ));
+            }
+            compare_critical(&b2, &n2)
+        }
     };
     Ok(Comparison {
         baseline: baseline.to_path_buf(),
@@ -345,6 +458,9 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
         critical_compared,
         critical,
         runs: [run_info(baseline), run_info(new)],
+        spec_differences,
+        not_comparable,
+        warnings,
         new_rows,
     })
 }
@@ -390,13 +506,35 @@ pub fn write_report(c: &Comparison, path: &Path) -> Result<PathBuf, ChartError> 
     let _ = writeln!(md, "# whirlmap compare\n");
     let _ = writeln!(
         md,
-        "**{}**: {} of {} points and {} of {} critical speeds changed beyond the thresholds.\n",
+        "**{}**: {} of {} points and {} of {} critical speeds changed beyond the thresholds{}.\n",
         if c.changed() { "CHANGED" } else { "SAME" },
         c.points.len(),
         c.points_compared,
         c.critical.len(),
-        c.critical_compared
+        c.critical_compared,
+        if c.spec_differences.is_empty() {
+            ""
+        } else {
+            " (the specs differ: see below)"
+        }
     );
+    for w in &c.warnings {
+        let _ = writeln!(md, "**Warning**: {w}\n");
+    }
+    if !c.spec_differences.is_empty() {
+        let _ = writeln!(md, "## The specs differ\n");
+        for d in &c.spec_differences {
+            let _ = writeln!(md, "- `{d}`");
+        }
+        let _ = writeln!(md);
+    }
+    if !c.not_comparable.is_empty() {
+        let _ = writeln!(md, "## Not comparable\n");
+        for d in &c.not_comparable {
+            let _ = writeln!(md, "- {d}");
+        }
+        let _ = writeln!(md);
+    }
     let _ = writeln!(md, "| | baseline | new |\n|---|---|---|");
     let _ = writeln!(
         md,
@@ -411,6 +549,7 @@ pub fn write_report(c: &Comparison, path: &Path) -> Result<PathBuf, ChartError> 
         "| model version | {} | {} |",
         b.model_version, n.model_version
     );
+    let _ = writeln!(md, "| spec hash | {} | {} |", b.spec_hash, n.spec_hash);
     let _ = writeln!(md, "| git commit | {} | {} |\n", b.git_commit, n.git_commit);
     let _ = writeln!(
         md,

@@ -29,6 +29,7 @@ use crate::classify::OrbitClass;
 use crate::recheck::Recheck;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use whirlmap_core::scene::num;
 use whirlmap_core::{simulate, DropOptions, InvalidParameter, Scene, MODEL_VERSION};
 
 /// Default lattice step of the scan (r/min).
@@ -161,16 +162,6 @@ impl CriticalOptions {
     }
 }
 
-/// A number for messages: plain when of ordinary size, in exponent form otherwise (so
-/// 1e-300 is not printed as three hundred zeros).
-fn num(v: f64) -> String {
-    if v != 0.0 && v.is_finite() && !(1e-3..1e9).contains(&v.abs()) {
-        format!("{v:e}")
-    } else {
-        v.to_string()
-    }
-}
-
 /// Checks a search range: `from_rpm` in [0, 1e6), `to_rpm` in (`from_rpm`, 1e6],
 /// `resolution_rpm` in [1, 1e5] with at most 10 000 lattice steps in the range, and `tol_rpm`
 /// in [0.01, `resolution_rpm`]. The error names the field.
@@ -191,7 +182,7 @@ pub fn check_range(
         return Err(InvalidParameter::new(
             "to_rpm",
             num(to_rpm),
-            &format!("({from_rpm}, 1e6] r/min (above from_rpm)"),
+            &format!("({}, 1e6] r/min (above from_rpm)", num(from_rpm)),
         ));
     }
     if !(resolution_rpm.is_finite() && (1.0..=1e5).contains(&resolution_rpm)) {
@@ -215,7 +206,10 @@ pub fn check_range(
         return Err(InvalidParameter::new(
             "tol_rpm",
             num(tol_rpm),
-            &format!("[0.01, {resolution_rpm}] r/min (at most the resolution)"),
+            &format!(
+                "[0.01, {}] r/min (at most the resolution)",
+                num(resolution_rpm)
+            ),
         ));
     }
     Ok(())
@@ -228,10 +222,10 @@ pub fn check_mus(mus: &[f64]) -> Result<(), InvalidParameter> {
     }
     for (i, &mu) in mus.iter().enumerate() {
         if !(mu.is_finite() && (0.0..=2.0).contains(&mu)) {
-            return Err(InvalidParameter::new("mu", mu, "[0, 2]"));
+            return Err(InvalidParameter::new("mu", num(mu), "[0, 2]"));
         }
         if mus[..i].contains(&mu) {
-            return Err(InvalidParameter::new("mu", mu, "each value once"));
+            return Err(InvalidParameter::new("mu", num(mu), "each value once"));
         }
     }
     Ok(())

@@ -61,7 +61,6 @@ use crate::sweep::{run_case, Inputs, SweepError};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use whirlmap_core::scene::fnv1a64;
@@ -479,10 +478,11 @@ pub fn load(path: impl AsRef<Path>) -> Result<EnsembleSpec, SpecError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let spec: EnsembleSpec = serde_json::from_str(&text).map_err(|source| SpecError::Parse {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let spec: EnsembleSpec =
+        whirlmap_core::json::from_str(&text).map_err(|source| SpecError::Parse {
+            path: path.to_path_buf(),
+            source,
+        })?;
     spec.cells()?;
     Ok(spec)
 }
@@ -886,15 +886,8 @@ pub struct EnsembleOutcome {
     pub written: Vec<PathBuf>,
 }
 
-fn io(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError + '_ {
-    move |source| SweepError::Io {
-        path: path.to_path_buf(),
-        source,
-    }
-}
-
 fn write_file(path: &Path, text: &str, written: &mut Vec<PathBuf>) -> Result<(), SweepError> {
-    std::fs::write(path, text).map_err(io(path))?;
+    crate::folder::write_atomic(path, text.as_bytes())?;
     written.push(path.to_path_buf());
     Ok(())
 }
@@ -979,11 +972,11 @@ pub fn run_ensemble(
     let mut progress = |done: usize, total: usize| {
         if show_progress && (last.elapsed() >= Duration::from_secs(5) || done == total) {
             last = Instant::now();
-            eprintln!(
+            crate::sweep::progress_line(&format!(
                 "ensemble {}: {done}/{total} drops, {:.0} s",
                 spec.name,
                 start.elapsed().as_secs_f64()
-            );
+            ));
         }
     };
     let members = pool.install(|| run_members(params, &cells, spec.duration_s, &mut progress));
@@ -1032,10 +1025,11 @@ pub fn run_ensemble(
         "wall_time_s": start.elapsed().as_secs_f64(),
     });
     let text = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-    let path = out_dir.join(MANIFEST_FILE);
-    let mut f = std::fs::File::create(&path).map_err(io(&path))?;
-    writeln!(f, "{text}").map_err(io(&path))?;
-    written.push(path);
+    write_file(
+        &out_dir.join(MANIFEST_FILE),
+        &format!("{text}\n"),
+        &mut written,
+    )?;
     Ok(EnsembleOutcome {
         cells: cells.len(),
         drops: members.len(),

@@ -22,6 +22,8 @@ pub enum ExtrasError {
     },
 }
 
+/// Writes `text` to `path` all or nothing ([`crate::folder::write_atomic`]), creating its
+/// folder.
 fn write(path: &Path, text: &str) -> Result<(), ExtrasError> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|source| ExtrasError::Io {
@@ -29,10 +31,20 @@ fn write(path: &Path, text: &str) -> Result<(), ExtrasError> {
             source,
         })?;
     }
-    std::fs::write(path, text).map_err(|source| ExtrasError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    crate::folder::write_atomic(path, text.as_bytes()).map_err(ExtrasError::from_sweep)
+}
+
+impl ExtrasError {
+    /// The same failure from the sweep's writers.
+    pub fn from_sweep(e: crate::sweep::SweepError) -> Self {
+        match e {
+            crate::sweep::SweepError::Io { path, source } => ExtrasError::Io { path, source },
+            other => ExtrasError::Io {
+                path: PathBuf::new(),
+                source: std::io::Error::other(other.to_string()),
+            },
+        }
+    }
 }
 
 /// The files the extras wrote.
@@ -99,13 +111,7 @@ pub fn run_probability(
         return Ok(None);
     };
     let dir = out_dir.join(PROBABILITY_DIR);
-    crate::ensemble::run_ensemble(&e, &dir, threads, progress).map_err(|err| match err {
-        crate::sweep::SweepError::Io { path, source } => ExtrasError::Io { path, source },
-        other => ExtrasError::Io {
-            path: dir.clone(),
-            source: std::io::Error::other(other.to_string()),
-        },
-    })?;
+    crate::ensemble::run_ensemble(&e, &dir, threads, progress).map_err(ExtrasError::from_sweep)?;
     Ok(Some(dir))
 }
 
@@ -170,16 +176,18 @@ pub fn orbit_panels(spec: &SweepSpec) -> Option<(f64, Vec<f64>)> {
     if !spec.charts.iter().any(|c| c == "orbits") {
         return None;
     }
-    let points = spec.points().ok()?;
+    // The `mu` axis's values in axis order: the order in which the grid first meets them.
+    let axis = spec.axes.0.iter().find(|a| a.name == "mu")?;
     let mut mus: Vec<f64> = Vec::new();
-    for p in &points {
-        for (name, v) in &p.inputs {
-            if name == "mu" && !mus.contains(v) {
-                mus.push(*v);
-            }
+    for i in 0..axis.values.count() {
+        let v = axis.values.value(i);
+        if !mus.contains(&v) {
+            mus.push(v);
+        }
+        if mus.len() == 8 {
+            break;
         }
     }
-    mus.truncate(8);
     (!mus.is_empty()).then_some((8000.0, mus))
 }
 

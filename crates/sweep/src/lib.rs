@@ -6,6 +6,8 @@
 //! - [`render`] and [`fonts`]: charts with an embedded font (no system fonts needed).
 //! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
 //!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
+//! - [`folder`]: a results folder's lock, its manifest's file list and the checks of a
+//!   reader; [`build_info`]: the build (version and commit) every manifest records.
 //! - [`shard`] and [`merge`]: a sweep split over machines and joined again.
 //! - [`compare`]: what changed between two results (nightly jobs).
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
@@ -21,6 +23,7 @@
 pub mod accuracy;
 pub mod accuracy_chart;
 pub mod adaptive;
+pub mod build_info;
 pub mod charts;
 pub mod classify;
 pub mod compare;
@@ -29,6 +32,7 @@ pub mod ensemble;
 pub mod extras;
 pub mod extremes;
 pub mod fig4;
+pub mod folder;
 pub mod fonts;
 pub mod merge;
 pub mod overrides;

@@ -2,8 +2,11 @@
 //!
 //! The merge refuses, listing every problem it finds, when
 //! - a folder is not a shard's output (no `shard.json`), or the shards come from different
-//!   specs (spec hash), shard counts or model versions, or from another model version than
-//!   this binary's;
+//!   specs (spec hash), shard counts, model versions or builds (whirlmap version and commit:
+//!   a different commit may change results even under the same model version, so shards of
+//!   two builds are never joined), or from another model version than this binary's;
+//! - a shard is still running (its folder is locked), or a file it hands over
+//!   (`critical.json`, `orbits/`, `probability/`) is not the one its manifest lists;
 //! - a grid point is missing (named with its index and inputs, grouped by the shard that owns
 //!   it, which is named with its folder and whether it finished), present twice, or not in
 //!   the spec's grid;
@@ -12,20 +15,24 @@
 //! Otherwise it writes `points.jsonl` (the shards' lines, verbatim, in grid order),
 //! `summary.csv`, `critical.json` and `orbits/` byte-identical to a single-machine run of the
 //! same spec, a `manifest.json` of the same form (counts and classes identical; run times,
-//! threads and git commit taken from the shards, plus `merged_from`), `timings.jsonl` (the
-//! shards' wall times in grid order), and the charts.
+//! threads and build taken from the shards, plus `merged_from`), `timings.jsonl` (the
+//! shards' wall times in grid order), and the charts. The output folder is taken as a sweep
+//! takes it ([`crate::folder`]): locked, and refused when it holds another run's files
+//! unless `overwrite`.
 
 use crate::charts::{render_all, ChartError};
 use crate::critical::CriticalRow;
 use crate::extras::{orbit_panels, write_critical, CRITICAL_FILE, PROBABILITY_DIR};
+use crate::folder::{self, Mode, RunFolder, RunIdentity};
 use crate::shard::{read_shard_manifest, spec_hash, Shard, ShardManifest};
-use crate::spec::{check_output_dir, Point, SpecError};
+use crate::spec::SpecError;
 use crate::sweep::{
-    io_err, point_key, write_atomic, write_summary_and_manifest, RunMeta, SweepError,
-    MANIFEST_FILE, POINTS_FILE, TIMINGS_FILE,
+    io_err, point_key, write_manifest, write_summary, RunMeta, RunRecord, SweepError,
+    MANIFEST_FILE, POINTS_FILE, SUMMARY_FILE, TIMINGS_FILE,
 };
 use serde_json::{json, Value};
 use std::collections::{BTreeMap, HashMap};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 use whirlmap_core::MODEL_VERSION;
@@ -55,9 +62,9 @@ impl MergeError {
     pub fn exit_code(&self) -> u8 {
         match self {
             MergeError::Refused(_) | MergeError::Spec(_) => 2,
-            MergeError::Output(SweepError::Spec(SpecError::Output { .. })) => 4,
-            MergeError::Output(SweepError::Spec(_)) => 2,
-            MergeError::Output(_) | MergeError::Charts(_) => 4,
+            MergeError::Output(e) => e.exit_code(),
+            MergeError::Charts(e) if e.is_output() => 4,
+            MergeError::Charts(_) => 2,
         }
     }
 }
@@ -79,6 +86,9 @@ pub struct MergeOutcome {
     pub classes: BTreeMap<String, usize>,
     /// Chart files drawn.
     pub charts: Vec<PathBuf>,
+    /// What could not be checked (shards written by an older whirlmap, a build without a
+    /// known commit), to be said loudly.
+    pub warnings: Vec<String>,
 }
 
 /// One shard folder as read.
@@ -110,8 +120,14 @@ impl ShardDir {
     }
 }
 
-fn point_text(p: &Point) -> String {
-    format!("#{} ({})", p.index, p.inputs_text())
+fn point_text(spec: &crate::spec::SweepSpec, index: usize) -> String {
+    let inputs = spec
+        .inputs_at(index)
+        .iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    format!("#{index} ({inputs})")
 }
 
 fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardDir>, MergeError> {
@@ -121,6 +137,13 @@ fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardDir>, MergeError> {
     let mut shards = Vec::new();
     let mut problems = Vec::new();
     for dir in dirs {
+        if let Some(who) = folder::running_writer(dir) {
+            problems.push(format!(
+                "{} is still being written ({who}): merge once that shard has finished",
+                dir.display()
+            ));
+            continue;
+        }
         match read_shard_manifest(dir) {
             Ok(m) => {
                 let finished = std::fs::read_to_string(dir.join(MANIFEST_FILE))
@@ -178,6 +201,18 @@ fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardDir>, MergeError> {
                 s.m.model_version
             ));
         }
+        if (&s.m.whirlmap_version, &s.m.git_commit)
+            != (&first.m.whirlmap_version, &first.m.git_commit)
+        {
+            problems.push(format!(
+                "the shards come from different builds: {} was run by whirlmap {}, {} by \
+                 whirlmap {} (rerun the shards with one build)",
+                first.dir.display(),
+                crate::build_info::describe(&first.m.whirlmap_version, &first.m.git_commit),
+                s.dir.display(),
+                crate::build_info::describe(&s.m.whirlmap_version, &s.m.git_commit)
+            ));
+        }
         if s.m.shards != first.m.shards {
             problems.push(format!(
                 "the shards come from different partitions: {} is shard {}, {} is shard {}",
@@ -197,15 +232,19 @@ fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardDir>, MergeError> {
 
 /// Merges the shard folders `dirs` into `out_dir` (see the module docs); draws the charts
 /// the spec lists. `out_dir` must not be one of the shard folders.
-pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeError> {
+pub fn merge(
+    dirs: &[PathBuf],
+    out_dir: &Path,
+    overwrite: bool,
+) -> Result<MergeOutcome, MergeError> {
     let shards = read_shards(dirs)?;
     let spec = shards[0].m.spec.clone();
     let count = shards[0].m.shards;
-    let points = spec.points()?;
-    let keys: Vec<String> = points
-        .iter()
-        .map(|p| point_key(&p.scene, spec.duration_s))
-        .collect();
+    let grid = spec.grid()?;
+    let n_points = grid.len();
+    let keys: Vec<String> = (0..n_points)
+        .map(|i| grid.point(i).map(|p| point_key(&p.scene, spec.duration_s)))
+        .collect::<Result<_, _>>()?;
     let by_key: HashMap<&str, usize> = keys
         .iter()
         .enumerate()
@@ -232,7 +271,7 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
     }
 
     // Every record line, by grid index.
-    let mut lines: Vec<Vec<(usize, String)>> = vec![Vec::new(); points.len()];
+    let mut lines: Vec<Vec<(usize, String)>> = vec![Vec::new(); n_points];
     for (d, s) in shards.iter().enumerate() {
         let path = s.dir.join(POINTS_FILE);
         let text = match std::fs::read_to_string(&path) {
@@ -261,7 +300,7 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
             }
         }
     }
-    for (p, found) in points.iter().zip(&lines) {
+    for (index, found) in lines.iter().enumerate() {
         if found.len() > 1 {
             let wher: Vec<String> = found
                 .iter()
@@ -269,32 +308,35 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
                 .collect();
             problems.push(format!(
                 "point {} is present {} times: in {}",
-                point_text(p),
+                point_text(&spec, index),
                 found.len(),
                 wher.join(", ")
             ));
         }
     }
     // Missing points, grouped by their owner.
-    let mut missing: BTreeMap<usize, Vec<&Point>> = BTreeMap::new();
-    for (p, found) in points.iter().zip(&lines) {
+    let mut missing: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (index, found) in lines.iter().enumerate() {
         if found.is_empty() {
             missing
-                .entry(Shard::owner_of(p.index, count))
+                .entry(Shard::owner_of(index, count))
                 .or_default()
-                .push(p);
+                .push(index);
         }
     }
     for (owner, ps) in &missing {
-        let owned = points
-            .iter()
-            .filter(|p| Shard::owner_of(p.index, count) == *owner)
+        let owned = (0..n_points)
+            .filter(|i| Shard::owner_of(*i, count) == *owner)
             .count();
         let who = match claims.get(owner) {
             Some(ds) => shards[ds[0]].name(),
             None => format!("shard {owner}/{count} (no folder given)"),
         };
-        let mut list: Vec<String> = ps.iter().take(MAX_LISTED).map(|p| point_text(p)).collect();
+        let mut list: Vec<String> = ps
+            .iter()
+            .take(MAX_LISTED)
+            .map(|i| point_text(&spec, *i))
+            .collect();
         if ps.len() > MAX_LISTED {
             list.push(format!("and {} more", ps.len() - MAX_LISTED));
         }
@@ -442,84 +484,188 @@ pub fn merge(dirs: &[PathBuf], out_dir: &Path) -> Result<MergeOutcome, MergeErro
             ));
         }
     }
+    // Each file handed over must be the one its shard's manifest lists.
+    let mut warnings = Vec::new();
+    // (A shard that did not finish is refused above already.)
+    for (d, s) in shards.iter().enumerate().filter(|(_, s)| s.m.complete) {
+        let mut inputs: Vec<String> = Vec::new();
+        if spec.critical.is_some() && !s.m.critical_mu.is_empty() {
+            inputs.push(CRITICAL_FILE.to_string());
+        }
+        let prefix = s.dir.clone();
+        for f in orbit_files
+            .iter()
+            .chain(probability_files.iter())
+            .filter(|f| f.starts_with(&prefix))
+        {
+            if let Ok(rel) = f.strip_prefix(&prefix) {
+                inputs.push(
+                    rel.components()
+                        .map(|c| c.as_os_str().to_string_lossy())
+                        .collect::<Vec<_>>()
+                        .join("/"),
+                );
+            }
+        }
+        inputs.push(POINTS_FILE.to_string());
+        inputs.retain(|f| shards[d].dir.join(f).is_file());
+        match folder::check_inputs(&s.dir, &inputs) {
+            Ok(c) => warnings.extend(
+                c.warnings
+                    .into_iter()
+                    .filter(|w| !w.contains("did not finish")),
+            ),
+            Err(p) => problems.extend(p),
+        }
+    }
+    if shards[0].m.git_commit == "unknown" {
+        warnings.push(format!(
+            "the shards' build has no known commit (whirlmap {}): that they come from one \
+             build cannot be checked beyond the version",
+            shards[0].m.whirlmap_version
+        ));
+    }
     if !problems.is_empty() {
         return Err(MergeError::Refused(problems));
     }
-
-    // Write.
-    check_output_dir(out_dir).map_err(SweepError::from)?;
-    let chosen: Vec<&str> = lines.iter().map(|l| l[0].1.as_str()).collect();
-    let mut text = String::new();
-    for l in &chosen {
-        text.push_str(l);
-        text.push('\n');
+    if (
+        &shards[0].m.whirlmap_version,
+        shards[0].m.git_commit.as_str(),
+    ) != (
+        &crate::build_info::VERSION.to_string(),
+        crate::build_info::GIT_COMMIT,
+    ) {
+        warnings.push(format!(
+            "the shards were run by whirlmap {}, this merge is {}: the records are the \
+             shards', the summary and charts this build's",
+            crate::build_info::describe(&shards[0].m.whirlmap_version, &shards[0].m.git_commit),
+            crate::build_info::DESCRIPTION
+        ));
     }
-    write_atomic(&out_dir.join(POINTS_FILE), text.as_bytes())?;
+
+    // Write: the output folder is taken as a sweep takes it.
+    let hash = spec_hash(&spec);
+    let id = RunIdentity {
+        spec: &spec,
+        spec_hash: hash.clone(),
+        shard: None,
+    };
+    let mode = if overwrite {
+        Mode::Overwrite
+    } else {
+        Mode::Fresh
+    };
+    let (mut out, _) = RunFolder::prepare(out_dir, "merge", &id, mode)?;
+    let mut record = RunRecord {
+        spec: spec.clone(),
+        spec_hash: hash,
+        meta: merged_meta(&shards),
+        counts: None,
+        classes: None,
+    };
+    write_manifest(&out, &record, false)?;
+    let chosen: Vec<&str> = lines.iter().map(|l| l[0].1.as_str()).collect();
+    folder::write_atomic_with(&out_dir.join(POINTS_FILE), |w| {
+        for l in &chosen {
+            w.write_all(l.as_bytes())?;
+            w.write_all(b"\n")?;
+        }
+        Ok(())
+    })?;
+    out.release_previous()?;
     write_timings(&shards, &out_dir.join(TIMINGS_FILE))?;
     if spec.critical.is_some() {
         let rows: Vec<CriticalRow> = critical_rows.into_iter().flatten().collect();
         write_critical(out_dir, &rows).map_err(|e| match e {
             crate::extras::ExtrasError::Io { path, source } => SweepError::Io { path, source },
         })?;
+        out.record(CRITICAL_FILE)?;
+        out.record(crate::extras::CRITICAL_CSV_FILE)?;
     }
-    if !orbit_files.is_empty() {
-        let dir = out_dir.join("orbits");
-        std::fs::create_dir_all(&dir).map_err(io_err(&dir))?;
-        for src in &orbit_files {
-            let dst = dir.join(src.file_name().expect("orbit files have names"));
-            std::fs::copy(src, &dst).map_err(io_err(&dst))?;
+    for (files, sub) in [
+        (&orbit_files, "orbits"),
+        (&probability_files, PROBABILITY_DIR),
+    ] {
+        if files.is_empty() {
+            continue;
         }
-    }
-    if !probability_files.is_empty() {
-        let dir = out_dir.join(PROBABILITY_DIR);
+        let dir = out_dir.join(sub);
         std::fs::create_dir_all(&dir).map_err(io_err(&dir))?;
-        for src in &probability_files {
-            let dst = dir.join(src.file_name().expect("probability files have names"));
-            std::fs::copy(src, &dst).map_err(io_err(&dst))?;
+        for src in files {
+            let dst = dir.join(src.file_name().expect("merged files have names"));
+            let bytes = std::fs::read(src).map_err(io_err(src))?;
+            folder::write_atomic(&dst, &bytes)?;
         }
+        out.record_tree(sub)?;
     }
-    let meta = merged_meta(&shards);
-    let (ok, failed, classes) = write_summary_and_manifest(&spec, out_dir, &points, &chosen, meta)?;
+    let (ok, failed, classes) = write_summary(&spec, out_dir, &mut (0..n_points))?;
+    for f in [POINTS_FILE, TIMINGS_FILE, SUMMARY_FILE] {
+        out.record(f)?;
+    }
+    record.counts = Some(crate::sweep::Counts {
+        points: n_points,
+        ok,
+        failed,
+        skipped: record_skipped(&shards),
+    });
+    record.classes = Some(classes.clone());
+    write_manifest(&out, &record, false)?;
     let charts = if spec.charts.is_empty() {
         Vec::new()
     } else {
         render_all(out_dir)?
     };
+    out.record_tree("charts")?;
+    record.meta.ended_unix_s = merged_end(&shards);
+    write_manifest(&out, &record, true)?;
     Ok(MergeOutcome {
         name: spec.name.clone(),
         shards: count,
-        points: points.len(),
+        points: n_points,
         ok,
         failed,
         classes,
         charts,
+        warnings,
     })
 }
 
-/// Run facts of the merged manifest: the earliest start and latest end of the shards, their
-/// threads and resumed points summed, the first shard's git commit, and the shards.
+/// The resumed points of the shards, summed.
+fn record_skipped(shards: &[ShardDir]) -> usize {
+    shards
+        .iter()
+        .filter_map(|s| s.finished.as_ref())
+        .filter_map(|m| m.pointer("/counts/skipped").and_then(Value::as_u64))
+        .sum::<u64>() as usize
+}
+
+/// The latest end time of the shards.
+fn merged_end(shards: &[ShardDir]) -> Option<f64> {
+    shards
+        .iter()
+        .filter_map(|s| s.finished.as_ref())
+        .filter_map(|m| m.get("ended_unix_s").and_then(Value::as_f64))
+        .reduce(f64::max)
+}
+
+/// Run facts of the merged manifest: the earliest start of the shards, their threads summed,
+/// their build (the same in every shard), and the shards.
 fn merged_meta(shards: &[ShardDir]) -> RunMeta {
     let field = |s: &ShardDir, k: &str| s.finished.as_ref().and_then(|m| m.get(k)).cloned();
-    let f64s = |k: &'static str| shards.iter().filter_map(move |s| field(s, k)?.as_f64());
-    let counts = |s: &ShardDir, k: &str| {
-        field(s, "counts")
-            .and_then(|c| c.get(k).and_then(Value::as_u64))
-            .unwrap_or(0) as usize
-    };
     let mut order: Vec<&ShardDir> = shards.iter().collect();
     order.sort_by_key(|s| s.m.shard);
     RunMeta {
-        git_commit: order
-            .first()
-            .and_then(|s| field(s, "git_commit"))
-            .and_then(|v| v.as_str().map(str::to_string)),
-        started_unix_s: f64s("started_unix_s").fold(f64::INFINITY, f64::min),
-        ended_unix_s: f64s("ended_unix_s").fold(0.0, f64::max),
+        whirlmap_version: order[0].m.whirlmap_version.clone(),
+        git_commit: order[0].m.git_commit.clone(),
+        started_unix_s: shards
+            .iter()
+            .filter_map(|s| field(s, "started_unix_s")?.as_f64())
+            .fold(f64::INFINITY, f64::min),
+        ended_unix_s: None,
         threads: shards
             .iter()
             .filter_map(|s| field(s, "threads")?.as_u64())
             .sum::<u64>() as usize,
-        skipped: shards.iter().map(|s| counts(s, "skipped")).sum(),
         shard: None,
         merged_from: Some(Value::Array(
             order
@@ -556,5 +702,5 @@ fn write_timings(shards: &[ShardDir], path: &Path) -> Result<(), SweepError> {
         text.push_str(&l);
         text.push('\n');
     }
-    std::fs::write(path, text).map_err(io_err(path))
+    folder::write_atomic(path, text.as_bytes())
 }

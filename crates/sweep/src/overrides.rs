@@ -44,7 +44,28 @@ pub fn apply_assignment(scene: &mut Scene, assignment: &str) -> Result<(), Overr
 /// Sets the scene parameter `key` (dotted for nested fields) to `value`.
 pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideError> {
     let mut root = serde_json::to_value(&*scene).expect("a scene serialises");
-    let mut node = &mut root;
+    set_value(&mut root, key, value)?;
+    let parsed: Scene =
+        serde_json::from_value(root.clone()).map_err(|e| OverrideError::BadValue {
+            key: key.to_string(),
+            reason: e.to_string(),
+        })?;
+    // A list where the scene has an object would be read by position.
+    whirlmap_core::json::check_objects(&root, &parsed).map_err(|reason| {
+        OverrideError::BadValue {
+            key: key.to_string(),
+            reason,
+        }
+    })?;
+    *scene = parsed;
+    Ok(())
+}
+
+/// Sets `key` (dotted for nested fields) to `value` in `root`, a scene as JSON (from
+/// `serde_json::to_value`), checking the key as [`apply`] does but not the value: the
+/// caller deserialises the scene once after setting every key (a sweep's grid point).
+pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), OverrideError> {
+    let mut node = root;
     let parts: Vec<&str> = key.split('.').collect();
     for (i, part) in parts.iter().enumerate() {
         let obj = match node {
@@ -76,8 +97,8 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
             });
         }
         if i + 1 == parts.len() {
-            obj.insert(part.to_string(), value.clone());
-            break;
+            obj.insert(part.to_string(), value);
+            return Ok(());
         }
         // An optional section that is absent (e.g. `thermal` on a drop without it) has no
         // sub-keys to set: say so instead of failing deeper.
@@ -89,10 +110,6 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
         };
         node = next;
     }
-    *scene = serde_json::from_value(root).map_err(|e| OverrideError::BadValue {
-        key: key.to_string(),
-        reason: e.to_string(),
-    })?;
     Ok(())
 }
 

@@ -16,8 +16,9 @@
 //! died lacks; `complete` in it turns true when everything is written. Charts are drawn by the merge, not by shards.
 
 use crate::extras::{run_all_owned, ExtrasError};
-use crate::spec::{check_output_dir, SweepSpec};
-use crate::sweep::{point_key, run_sweep_part, write_atomic, RunOptions, SweepError, SweepOutcome};
+use crate::folder::write_atomic;
+use crate::spec::SweepSpec;
+use crate::sweep::{point_key, run_grid, start_run, RunOptions, SweepError, SweepOutcome};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -106,6 +107,10 @@ pub struct ShardManifest {
     pub model_version: u32,
     /// The whirlmap package version of that binary.
     pub whirlmap_version: String,
+    /// The commit that binary was built from ([`crate::build_info::GIT_COMMIT`]); `unknown`
+    /// for a shard written by an older whirlmap.
+    #[serde(default = "unknown")]
+    pub git_commit: String,
     /// The grid points owned, in grid order.
     pub points: Vec<OwnedPoint>,
     /// Positions in `critical.mu` owned, increasing.
@@ -120,6 +125,10 @@ pub struct ShardManifest {
     pub spec: SweepSpec,
 }
 
+fn unknown() -> String {
+    "unknown".to_string()
+}
+
 /// Stable FNV-1a 64 hash of the spec's canonical JSON (16 hex digits): shards of the same
 /// sweep have the same hash.
 pub fn spec_hash(spec: &SweepSpec) -> String {
@@ -129,15 +138,17 @@ pub fn spec_hash(spec: &SweepSpec) -> String {
 
 /// The [`ShardManifest`] of `shard` for `spec` (validates the spec).
 pub fn shard_manifest(spec: &SweepSpec, shard: Shard) -> Result<ShardManifest, SweepError> {
-    let points = spec
-        .points()?
-        .into_iter()
-        .filter(|p| shard.owns(p.index))
-        .map(|p| OwnedPoint {
-            index: p.index,
-            key: point_key(&p.scene, spec.duration_s),
+    let grid = spec.grid()?;
+    let points = (shard.index..grid.len())
+        .step_by(shard.count)
+        .map(|index| {
+            let p = grid.point(index)?;
+            Ok(OwnedPoint {
+                index,
+                key: point_key(&p.scene, spec.duration_s),
+            })
         })
-        .collect();
+        .collect::<Result<Vec<_>, SweepError>>()?;
     let owned = |n: usize| (0..n).filter(|k| shard.owns(*k)).collect::<Vec<_>>();
     let n_orbits = crate::extras::orbit_panels(spec).map_or(0, |(_, mus)| mus.len());
     Ok(ShardManifest {
@@ -145,7 +156,8 @@ pub fn shard_manifest(spec: &SweepSpec, shard: Shard) -> Result<ShardManifest, S
         shards: shard.count,
         spec_hash: spec_hash(spec),
         model_version: MODEL_VERSION,
-        whirlmap_version: env!("CARGO_PKG_VERSION").to_string(),
+        whirlmap_version: crate::build_info::VERSION.to_string(),
+        git_commit: crate::build_info::GIT_COMMIT.to_string(),
         points,
         critical_mu: owned(spec.critical.as_ref().map_or(0, |c| c.mus().len())),
         orbit_panels: owned(n_orbits),
@@ -166,51 +178,44 @@ pub fn read_shard_manifest(dir: &Path) -> Result<ShardManifest, String> {
     serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// Runs shard `shard` of `spec`: writes [`SHARD_FILE`], runs the owned grid points (with
-/// `opts.resume` as for a whole sweep), then the owned critical searches and orbit panels.
-/// Refuses (before running anything) to resume into a folder holding another shard or spec.
+/// Runs shard `shard` of `spec`: takes the folder ([`crate::folder`]; `opts.resume` continues
+/// only the same shard of the same spec and build), writes [`SHARD_FILE`], runs the owned grid
+/// points, then the owned critical searches and orbit panels, listing every file in the
+/// manifest, which it marks complete at the end.
 pub fn run_shard(
     spec: &SweepSpec,
     opts: &RunOptions,
     shard: Shard,
 ) -> Result<(SweepOutcome, Option<PathBuf>), ShardRunError> {
+    let mut run = start_run(spec, opts, Some(&shard))?;
     let manifest = shard_manifest(spec, shard)?;
-    check_output_dir(&opts.out_dir).map_err(SweepError::from)?;
     let path = opts.out_dir.join(SHARD_FILE);
-    if opts.resume {
-        if let Ok(old) = read_shard_manifest(&opts.out_dir) {
-            if (old.shard, old.shards, &old.spec_hash)
-                != (shard.index, shard.count, &manifest.spec_hash)
-            {
-                return Err(ShardRunError::Mismatch(format!(
-                    "{} holds shard {}/{} of spec {}, not shard {} of spec {}: resume it with \
-                     the same spec and --shard/--shards, or use another --out",
-                    opts.out_dir.display(),
-                    old.shard,
-                    old.shards,
-                    old.spec_hash,
-                    shard.label(),
-                    manifest.spec_hash
-                )));
-            }
-        }
-    }
     let write = |m: &ShardManifest| {
         let text = serde_json::to_string_pretty(m).expect("shard manifests serialise");
         write_atomic(&path, format!("{text}\n").as_bytes())
     };
     write(&manifest)?;
-    let outcome = run_sweep_part(spec, opts, Some(&shard))?;
+    run.record(&path)?;
+    run_grid(spec, opts, Some(&shard), &mut run)?;
     let progress = opts.progress != crate::sweep::ProgressMode::Off;
-    let critical = run_all_owned(spec, &opts.out_dir, opts.threads, progress, |k| {
+    let x = run_all_owned(spec, &opts.out_dir, opts.threads, progress, |k| {
         shard.owns(k)
-    })?
-    .critical;
+    })?;
+    for p in x.critical.iter().chain(&x.probability) {
+        run.record(p)?;
+    }
+    if let Some(c) = &x.critical {
+        run.record(&c.with_file_name(crate::extras::CRITICAL_CSV_FILE))?;
+    }
+    run.record(&opts.out_dir.join("orbits"))?;
     write(&ShardManifest {
         complete: true,
         ..manifest
     })?;
-    Ok((outcome, critical))
+    run.record(&path)?;
+    let outcome = run.outcome.clone();
+    run.finish()?;
+    Ok((outcome, x.critical))
 }
 
 /// Why a shard could not run or write its outputs.
@@ -222,17 +227,15 @@ pub enum ShardRunError {
     /// The critical search or the orbits could not be written.
     #[error(transparent)]
     Extras(#[from] ExtrasError),
-    /// `--resume` into a folder of another shard or spec.
-    #[error("{0}")]
-    Mismatch(String),
 }
 
 impl ShardRunError {
-    /// Whether the error is bad input (exit 2) rather than an output failure (exit 4).
-    pub fn is_input(&self) -> bool {
+    /// The process exit code: 2 bad input or a refused folder (nothing run), 4 an output
+    /// could not be written.
+    pub fn exit_code(&self) -> u8 {
         match self {
-            ShardRunError::Sweep(SweepError::Io { .. }) | ShardRunError::Extras(_) => false,
-            ShardRunError::Sweep(_) | ShardRunError::Mismatch(_) => true,
+            ShardRunError::Sweep(e) => e.exit_code(),
+            ShardRunError::Extras(_) => 4,
         }
     }
 }

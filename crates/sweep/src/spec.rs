@@ -30,13 +30,19 @@ use serde_json::Value;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
+use whirlmap_core::scene::num;
 use whirlmap_core::{Fidelity, InvalidParameter, Scene};
 
 /// Chart names a spec may list.
 pub const CHART_NAMES: &[&str] = &["orbits", "critical", "max_force", "peak_power", "classes"];
 
-/// Largest grid a spec may describe.
+/// Largest grid a spec may describe (points). The count is checked, with checked arithmetic,
+/// before any axis is built; larger grids are refused (exit 2).
 pub const MAX_POINTS: usize = 10_000_000;
+
+/// Most friction coefficients a `critical` section may search (each is a search of up to
+/// 10 000 scan drops).
+pub const MAX_CRITICAL_MU: usize = 1000;
 
 /// Why a sweep spec is unusable. Every variant names the field and the value.
 #[derive(Debug, Error)]
@@ -73,7 +79,7 @@ pub enum SpecError {
         axis: String,
     },
     /// A range with `from > to`.
-    #[error("{field}: from = {from} is greater than to = {to}")]
+    #[error("{field}: from = {} is greater than to = {}", num(*from), num(*to))]
     ReversedRange {
         /// The range's field (`axes.speed_rpm`, `critical.speed_rpm`).
         field: String,
@@ -81,6 +87,15 @@ pub enum SpecError {
         from: f64,
         /// Upper end as given.
         to: f64,
+    },
+    /// A value listed twice in an axis or a list of friction coefficients (`0.0` and `-0.0`
+    /// are the same value; a range whose ends are equal repeats its one value).
+    #[error("{field}: the value {} occurs more than once: each grid value must be distinct (0 and -0 are the same value)", num(*value))]
+    DuplicateValue {
+        /// The field (`axes.mu`, `critical.mu`, `orbits.mu`, ...).
+        field: String,
+        /// The repeated value.
+        value: f64,
     },
     /// The same scene parameter named by two axes.
     #[error("axes.{axis}: sets the same scene parameter as another axis")]
@@ -97,7 +112,7 @@ pub enum SpecError {
         source: OverrideError,
     },
     /// A friction coefficient outside [0, 2].
-    #[error("{field} = {value}: friction coefficient must be in [0, 2]")]
+    #[error("{field} = {}: friction coefficient must be in [0, 2]", num(*value))]
     MuOutOfRange {
         /// `axes.mu` or `critical.mu`.
         field: String,
@@ -105,7 +120,7 @@ pub enum SpecError {
         value: f64,
     },
     /// `duration_s` not in (0, 3600].
-    #[error("duration_s = {value}: must be > 0 and at most 3600 s")]
+    #[error("duration_s = {}: must be > 0 and at most 3600 s", num(*value))]
     Duration {
         /// The value.
         value: f64,
@@ -228,28 +243,74 @@ struct RangeSteps {
 }
 
 impl AxisValues {
-    /// The axis's values in order (not validated).
-    pub fn values(&self) -> Vec<f64> {
+    /// The number of values, without building them.
+    pub fn count(&self) -> usize {
         match self {
-            AxisValues::List(v) => v.clone(),
-            AxisValues::Range { from, to, steps } => match *steps {
-                0 => Vec::new(),
-                1 => vec![*from],
-                n => (0..n)
-                    .map(|i| {
-                        if i + 1 == n {
-                            *to
-                        } else {
-                            // Rounded to 12 significant digits, so 0.05 + 2 * 0.05 is written
-                            // 0.15, not 0.15000000000000002, in records, keys and CSV.
-                            let v = from + (to - from) * (i as f64) / ((n - 1) as f64);
-                            format!("{v:.11e}").parse().unwrap_or(v)
-                        }
-                    })
-                    .collect(),
-            },
+            AxisValues::List(v) => v.len(),
+            AxisValues::Range { steps, .. } => *steps,
         }
     }
+
+    /// Value `i` (`i < count()`), without building the others.
+    pub fn value(&self, i: usize) -> f64 {
+        match self {
+            AxisValues::List(v) => v[i],
+            AxisValues::Range { from, to, steps } => {
+                let n = *steps;
+                if n == 1 {
+                    *from
+                } else if i + 1 == n {
+                    *to
+                } else {
+                    // Rounded to 12 significant digits, so 0.05 + 2 * 0.05 is written 0.15,
+                    // not 0.15000000000000002, in records, keys and CSV.
+                    let v = from + (to - from) * (i as f64) / ((n - 1) as f64);
+                    format!("{v:.11e}").parse().unwrap_or(v)
+                }
+            }
+        }
+    }
+
+    /// The axis's values in order (not validated). Builds them all: check [`Self::count`]
+    /// first for a spec from a file.
+    pub fn values(&self) -> Vec<f64> {
+        (0..self.count()).map(|i| self.value(i)).collect()
+    }
+
+    /// The first value that occurs twice (`0.0` and `-0.0` are the same value), if any.
+    /// A range with `from < to` is increasing unless its spacing is below the 12 significant
+    /// digits its values are rounded to; only then are its values built and compared.
+    pub fn first_duplicate(&self) -> Option<f64> {
+        match self {
+            AxisValues::Range { from, to, steps } if *steps > 1 => {
+                let spacing = (to - from) / ((*steps - 1) as f64);
+                // Rounding to 12 significant digits moves a value by at most 5e-12 of its
+                // magnitude, so a spacing above 2e-11 of the largest keeps them apart.
+                if spacing > 2e-11 * from.abs().max(to.abs()) {
+                    return None;
+                }
+                let mut prev = self.value(0);
+                for i in 1..*steps {
+                    let v = self.value(i);
+                    if !(v > prev) {
+                        return Some(v);
+                    }
+                    prev = v;
+                }
+                None
+            }
+            AxisValues::Range { .. } => None,
+            AxisValues::List(v) => first_duplicate(v),
+        }
+    }
+}
+
+/// The first value of `values` that occurs twice (`0.0` and `-0.0` are the same value).
+pub fn first_duplicate(values: &[f64]) -> Option<f64> {
+    // + 0.0 turns -0.0 into 0.0, so the two sort together.
+    let mut sorted: Vec<f64> = values.iter().map(|v| v + 0.0).collect();
+    sorted.sort_by(f64::total_cmp);
+    sorted.windows(2).find(|w| w[0] == w[1]).map(|w| w[0])
 }
 
 impl<'de> Deserialize<'de> for AxisValues {
@@ -489,6 +550,23 @@ fn check_range(field: &str, from: f64, to: f64) -> Result<(), SpecError> {
     }
 }
 
+/// Reads and parses a spec and checks everything but the grid points' scenes
+/// ([`SweepSpec::validate`]: the grid's size first, before any axis is built). A sweep checks
+/// the points' scenes itself before it runs ([`crate::sweep::run_sweep`]), one at a time.
+pub fn read(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|source| SpecError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let spec = parse(&text).map_err(|source| SpecError::Parse {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    spec.validate()?;
+    Ok(spec)
+}
+
 /// Reads, parses and validates a spec (every grid point's scene included).
 pub fn load(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
     let path = path.as_ref();
@@ -500,14 +578,14 @@ pub fn load(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
         path: path.to_path_buf(),
         source,
     })?;
-    spec.validate()?;
-    spec.points()?;
+    spec.check_points()?;
     Ok(spec)
 }
 
-/// Parses spec text (no validation beyond types and unknown keys).
+/// Parses spec text (no validation beyond types, unknown keys, and lists where an object
+/// belongs: [`whirlmap_core::json::from_str`]).
 pub fn parse(text: &str) -> Result<SweepSpec, serde_json::Error> {
-    serde_json::from_str(text)
+    whirlmap_core::json::from_str(text)
 }
 
 impl SweepSpec {
@@ -535,23 +613,36 @@ impl SweepSpec {
         if self.axes.0.is_empty() {
             return Err(SpecError::NoAxes);
         }
-        let mut keys: Vec<&str> = Vec::new();
+        // The grid's size first, with checked arithmetic, before any axis is built.
         let mut total: usize = 1;
         for axis in &self.axes.0 {
+            let n = axis.values.count();
+            if n == 0 {
+                return Err(match axis.values {
+                    AxisValues::List(_) => SpecError::EmptyAxis {
+                        axis: axis.name.clone(),
+                    },
+                    AxisValues::Range { .. } => SpecError::ZeroSteps {
+                        axis: axis.name.clone(),
+                    },
+                });
+            }
+            total = match total.checked_mul(n) {
+                Some(t) if t <= MAX_POINTS => t,
+                _ => {
+                    return Err(SpecError::Invalid {
+                        field: "axes".into(),
+                        value: format!("{} grid points", grid_size_text(&self.axes)),
+                        allowed: format!("at most {MAX_POINTS} points"),
+                    })
+                }
+            };
+        }
+        let mut keys: Vec<&str> = Vec::new();
+        for axis in &self.axes.0 {
             let field = format!("axes.{}", axis.name);
-            match &axis.values {
-                AxisValues::List(v) if v.is_empty() => {
-                    return Err(SpecError::EmptyAxis {
-                        axis: axis.name.clone(),
-                    })
-                }
-                AxisValues::Range { steps: 0, .. } => {
-                    return Err(SpecError::ZeroSteps {
-                        axis: axis.name.clone(),
-                    })
-                }
-                AxisValues::Range { from, to, .. } => check_range(&field, *from, *to)?,
-                AxisValues::List(_) => {}
+            if let AxisValues::Range { from, to, .. } = &axis.values {
+                check_range(&field, *from, *to)?;
             }
             let key = axis.scene_key();
             if keys.contains(&key) {
@@ -560,28 +651,23 @@ impl SweepSpec {
                 });
             }
             keys.push(key);
-            let values = axis.values.values();
+            if let Some(value) = axis.values.first_duplicate() {
+                return Err(SpecError::DuplicateValue { field, value });
+            }
             if key == "mu_dynamic" {
-                for v in &values {
-                    check_mu(&field, *v)?;
+                for i in 0..axis.values.count() {
+                    check_mu(&field, axis.values.value(i))?;
                 }
             }
-            // Unknown names and values of the wrong type, checked on the base scene.
-            for v in &values {
-                let mut s = self.base_scene();
-                overrides::apply(&mut s, key, axis_json(*v)).map_err(|source| SpecError::Axis {
+            // An unknown name, checked on the base scene with the first value (the value
+            // types are checked with every grid point, [`SweepSpec::check_points`]).
+            let mut s = self.base_scene();
+            overrides::apply(&mut s, key, axis_json(axis.values.value(0))).map_err(|source| {
+                SpecError::Axis {
                     axis: axis.name.clone(),
                     source,
-                })?;
-            }
-            total = total.saturating_mul(values.len());
-        }
-        if total > MAX_POINTS {
-            return Err(SpecError::Invalid {
-                field: "axes".into(),
-                value: format!("{total} grid points"),
-                allowed: format!("at most {MAX_POINTS} points"),
-            });
+                }
+            })?;
         }
         if let Some(c) = &self.critical {
             if let AxisValues::Range { steps: 0, .. } = c.mu {
@@ -589,8 +675,21 @@ impl SweepSpec {
                     axis: "critical.mu".into(),
                 });
             }
+            if c.mu.count() > MAX_CRITICAL_MU {
+                return Err(SpecError::Invalid {
+                    field: "critical.mu".into(),
+                    value: format!("{} values", c.mu.count()),
+                    allowed: format!("at most {MAX_CRITICAL_MU} friction coefficients"),
+                });
+            }
             if let AxisValues::Range { from, to, .. } = c.mu {
                 check_range("critical.mu", from, to)?;
+            }
+            if let Some(value) = c.mu.first_duplicate() {
+                return Err(SpecError::DuplicateValue {
+                    field: "critical.mu".into(),
+                    value,
+                });
             }
             let mus = c.mus();
             for v in &mus {
@@ -629,10 +728,16 @@ impl SweepSpec {
             for v in &o.mu {
                 check_mu("orbits.mu", *v)?;
             }
+            if let Some(value) = first_duplicate(&o.mu) {
+                return Err(SpecError::DuplicateValue {
+                    field: "orbits.mu".into(),
+                    value,
+                });
+            }
             if !(o.speed_rpm.is_finite() && o.speed_rpm.abs() <= 1e6) {
                 return Err(SpecError::Invalid {
                     field: "orbits.speed_rpm".into(),
-                    value: o.speed_rpm.to_string(),
+                    value: num(o.speed_rpm),
                     allowed: "[-1e6, 1e6] r/min".into(),
                 });
             }
@@ -663,13 +768,14 @@ impl SweepSpec {
         Ok(())
     }
 
-    /// Number of grid points.
+    /// Number of grid points (saturating at `usize::MAX`; [`SweepSpec::validate`] refuses
+    /// more than [`MAX_POINTS`]).
     pub fn len(&self) -> usize {
         self.axes
             .0
             .iter()
-            .map(|a| a.values.values().len())
-            .product()
+            .try_fold(1usize, |t, a| t.checked_mul(a.values.count()))
+            .unwrap_or(usize::MAX)
     }
 
     /// Whether the grid is empty (only for an invalid spec).
@@ -677,62 +783,151 @@ impl SweepSpec {
         self.len() == 0
     }
 
-    /// Every grid point, row-major (first axis slowest), each scene validated.
-    pub fn points(&self) -> Result<Vec<Point>, SpecError> {
-        self.validate()?;
-        let axes: Vec<(&Axis, Vec<f64>)> =
-            self.axes.0.iter().map(|a| (a, a.values.values())).collect();
-        let total = self.len();
-        let mut points = Vec::with_capacity(total);
-        let mut idx = vec![0usize; axes.len()];
-        for index in 0..total {
-            let mut scene = self.base_scene();
-            let mut inputs = Vec::with_capacity(axes.len());
-            for (k, (axis, values)) in axes.iter().enumerate() {
-                let v = values[idx[k]];
-                overrides::apply(&mut scene, axis.scene_key(), axis_json(v)).map_err(|source| {
-                    SpecError::Axis {
-                        axis: axis.name.clone(),
-                        source,
-                    }
-                })?;
-                inputs.push((axis.name.clone(), v));
-            }
-            scene.validate().map_err(|source| SpecError::InvalidScene {
-                index,
-                inputs: inputs_text(&inputs),
-                source,
-            })?;
-            points.push(Point {
-                index,
-                inputs,
-                scene,
-            });
-            // Odometer: last axis fastest.
-            for k in (0..axes.len()).rev() {
-                idx[k] += 1;
-                if idx[k] < axes[k].1.len() {
-                    break;
-                }
-                idx[k] = 0;
-            }
+    /// The axis values of grid point `index` (row-major: the last axis varies fastest), in
+    /// axis order, computed from the index alone.
+    pub fn inputs_at(&self, index: usize) -> Vec<(String, f64)> {
+        let mut rest = index;
+        let mut inputs = vec![(String::new(), 0.0); self.axes.0.len()];
+        for (k, axis) in self.axes.0.iter().enumerate().rev() {
+            let n = axis.values.count().max(1);
+            inputs[k] = (axis.name.clone(), axis.values.value(rest % n));
+            rest /= n;
         }
-        Ok(points)
+        inputs
+    }
+
+    /// Grid point `index` with its scene, built and validated. `base` is
+    /// `serde_json::to_value(self.base_scene())`, made once by the caller ([`Grid`]).
+    fn point_from(&self, base: &Value, index: usize) -> Result<Point, SpecError> {
+        let inputs = self.inputs_at(index);
+        let mut root = base.clone();
+        for (axis, (_, v)) in self.axes.0.iter().zip(&inputs) {
+            overrides::set_value(&mut root, axis.scene_key(), axis_json(*v)).map_err(|source| {
+                SpecError::Axis {
+                    axis: axis.name.clone(),
+                    source,
+                }
+            })?;
+        }
+        let scene: Scene = match serde_json::from_value(root) {
+            Ok(s) => s,
+            Err(_) => {
+                // Find the axis whose value the scene does not take, for the message.
+                let mut scene = self.base_scene();
+                for (axis, (_, v)) in self.axes.0.iter().zip(&inputs) {
+                    overrides::apply(&mut scene, axis.scene_key(), axis_json(*v)).map_err(
+                        |source| SpecError::Axis {
+                            axis: axis.name.clone(),
+                            source,
+                        },
+                    )?;
+                }
+                scene
+            }
+        };
+        scene.validate().map_err(|source| SpecError::InvalidScene {
+            index,
+            inputs: inputs_text(&inputs),
+            source,
+        })?;
+        Ok(Point {
+            index,
+            inputs,
+            scene,
+        })
+    }
+
+    /// The grid, for building its points one at a time ([`Grid::point`]); validates the spec
+    /// (not the points: [`SweepSpec::check_points`]).
+    pub fn grid(&self) -> Result<Grid<'_>, SpecError> {
+        self.validate()?;
+        Ok(Grid {
+            spec: self,
+            base: serde_json::to_value(self.base_scene()).expect("a scene serialises"),
+            len: self.len(),
+        })
+    }
+
+    /// Validates the spec and every grid point's scene, one point at a time (nothing the
+    /// size of the grid is kept).
+    pub fn check_points(&self) -> Result<(), SpecError> {
+        let grid = self.grid()?;
+        for index in 0..grid.len() {
+            grid.point(index)?;
+        }
+        Ok(())
+    }
+
+    /// Every grid point, row-major (first axis slowest), each scene validated. This holds
+    /// the whole grid in memory: for small grids (an ensemble's cells, tests); a sweep
+    /// builds its points chunk by chunk with [`SweepSpec::grid`].
+    pub fn points(&self) -> Result<Vec<Point>, SpecError> {
+        let grid = self.grid()?;
+        (0..grid.len()).map(|i| grid.point(i)).collect()
+    }
+}
+
+/// A validated spec's grid: builds any point from its index, so nothing the size of the grid
+/// is held ([`SweepSpec::grid`]).
+#[derive(Debug, Clone)]
+pub struct Grid<'a> {
+    spec: &'a SweepSpec,
+    /// The base scene as JSON, cloned and edited per point.
+    base: Value,
+    len: usize,
+}
+
+impl Grid<'_> {
+    /// The number of grid points.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the grid has no points (never, for a validated spec).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Grid point `index` (< `len()`), its scene built and validated.
+    pub fn point(&self, index: usize) -> Result<Point, SpecError> {
+        self.spec.point_from(&self.base, index)
+    }
+}
+
+/// `a x b x c` (the axes' counts) for a message about a grid's size, with the product when
+/// it fits in 64 bits.
+fn grid_size_text(axes: &Axes) -> String {
+    let counts: Vec<String> = axes
+        .0
+        .iter()
+        .map(|a| a.values.count().to_string())
+        .collect();
+    let product = axes
+        .0
+        .iter()
+        .try_fold(1u128, |t, a| t.checked_mul(a.values.count() as u128));
+    match product {
+        Some(p) if axes.0.len() > 1 => format!("{} = {p}", counts.join(" x ")),
+        Some(p) => p.to_string(),
+        None => format!("{} (more than 2^128)", counts.join(" x ")),
     }
 }
 
 /// Creates `dir` (and parents) and writes and removes a probe file, so an unwritable output
-/// folder is reported before any drop runs.
-pub fn check_output_dir(dir: &Path) -> Result<(), SpecError> {
-    let err = |source| SpecError::Output {
-        path: dir.to_path_buf(),
-        source,
-    };
+/// folder is reported before any drop runs: a bad path (a file in the way, no permission) as
+/// [`SpecError::Output`] (exit 2), a storage failure (a full disk) as
+/// [`crate::sweep::SweepError::Io`] (exit 4). The probe is removed whatever happens.
+pub fn check_output_dir(dir: &Path) -> Result<(), crate::sweep::SweepError> {
+    let err = |source| crate::folder::output_error(dir, source);
     std::fs::create_dir_all(dir).map_err(err)?;
     let probe = dir.join(format!(".whirlmap-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"probe").map_err(err)?;
-    std::fs::remove_file(&probe).map_err(err)?;
-    Ok(())
+    let written = std::fs::write(&probe, b"probe");
+    let removed = std::fs::remove_file(&probe);
+    written.map_err(err)?;
+    match removed {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(err(e)),
+        _ => Ok(()),
+    }
 }
 
 #[cfg(test)]
@@ -807,6 +1002,45 @@ mod tests {
         let text = serde_json::to_string(&spec).unwrap();
         assert!(text.find("speed_rpm\":{").unwrap() < text.find("\"mu\":[").unwrap());
         assert_eq!(parse(&text).unwrap(), spec);
+    }
+
+    #[test]
+    fn axes_count_before_building_and_find_duplicates() {
+        let huge = AxisValues::Range {
+            from: 0.0,
+            to: 1.0,
+            steps: usize::MAX,
+        };
+        assert_eq!(huge.count(), usize::MAX);
+        assert_eq!(
+            huge.value(usize::MAX - 1),
+            1.0,
+            "one value, without the others"
+        );
+        let e =
+            err(|v| v["axes"]["mu"] = serde_json::json!({"from": 0, "to": 1, "steps": u64::MAX}));
+        assert!(e.contains("at most 10000000 points"), "{e}");
+        assert_eq!(first_duplicate(&[0.0, -0.0]), Some(0.0));
+        assert_eq!(first_duplicate(&[0.3, 0.1, 0.2]), None);
+        let flat = AxisValues::Range {
+            from: 0.2,
+            to: 0.2,
+            steps: 3,
+        };
+        assert_eq!(flat.first_duplicate(), Some(0.2));
+        let fine = AxisValues::Range {
+            from: 0.0,
+            to: 1.0,
+            steps: 1_000_001,
+        };
+        assert_eq!(fine.first_duplicate(), None);
+        // Spacing below the 12 digits the values are rounded to.
+        let tight = AxisValues::Range {
+            from: 1000.0,
+            to: 1000.0000000001,
+            steps: 3,
+        };
+        assert_eq!(tight.first_duplicate(), Some(1000.0));
     }
 
     #[test]
@@ -924,7 +1158,11 @@ mod tests {
         let file = dir.join("a-file");
         std::fs::write(&file, "x").unwrap();
         let e = check_output_dir(&file.join("sub")).unwrap_err();
-        assert!(matches!(e, SpecError::Output { .. }), "{e}");
+        assert!(
+            matches!(e, crate::sweep::SweepError::Spec(SpecError::Output { .. })),
+            "{e}"
+        );
+        assert_eq!(e.exit_code(), 2);
         check_output_dir(&dir.join("out")).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -8,14 +8,25 @@
 //!
 //! ## Crash safety and resume
 //! The grid runs in chunks of `4 x threads` points; within a chunk points run in parallel and
-//! their lines are appended in grid order and flushed when the chunk ends, each line with a
-//! single `write_all`. A kill loses at most the chunk in flight. `resume` reads the existing
-//! file, drops a torn last line (truncating the file back to the last complete line), skips
-//! points recorded `ok`, re-runs failed ones, and at the end rewrites the file in grid order
-//! with one line per point, so it is byte-identical to an uninterrupted run.
+//! their lines are appended in grid order, each line with a single `write_all`, then flushed
+//! and synced to disk (`fsync`) when the chunk ends. A kill, or a power loss, loses at most
+//! the chunk in flight. `resume` reads the existing file, drops a torn last line (truncating
+//! the file back to the last complete line), skips points recorded `ok` at their grid index,
+//! re-runs failed ones, and at the end rewrites the file in grid order with one line per
+//! point, so it is byte-identical to an uninterrupted run.
+//!
+//! ## The folder
+//! A run takes the folder's lock, refuses a folder holding another run's files unless told
+//! to resume (the same spec and build only) or overwrite, and lists every file it writes in
+//! `manifest.json` ([`crate::folder`]).
+//!
+//! ## Memory
+//! Grid points are built from their index chunk by chunk ([`crate::spec::Grid`]); nothing
+//! the size of the grid is held but, on a resume, the records read back.
 
+use crate::folder::{self, FileEntry, Mode, RunFolder, RunIdentity};
 use crate::record::DropRecord;
-use crate::spec::{check_output_dir, Point, SpecError, SweepSpec};
+use crate::spec::{Grid, Point, SpecError, SweepSpec};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use serde::ser::{SerializeMap, Serializer};
@@ -23,7 +34,7 @@ use serde::Serialize;
 use serde_json::Value;
 use std::collections::{BTreeMap, HashMap};
 use std::fs::OpenOptions;
-use std::io::{IsTerminal, Read, Seek, SeekFrom, Write};
+use std::io::{BufRead, IsTerminal, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -58,6 +69,21 @@ pub enum SweepError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// The output folder may not be written as asked: another process writes it, it holds
+    /// another run's results, or a resume does not match what it holds. Nothing was run.
+    #[error("{0}")]
+    Refused(String),
+}
+
+impl SweepError {
+    /// The process exit code: 2 for a bad spec, option or output folder (nothing run), 4
+    /// when an output could not be written (a full disk included).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            SweepError::Spec(_) | SweepError::ThreadPool(_) | SweepError::Refused(_) => 2,
+            SweepError::Io { .. } => 4,
+        }
+    }
 }
 
 pub(crate) fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError + '_ {
@@ -211,8 +237,12 @@ pub struct RunOptions {
     pub out_dir: PathBuf,
     /// Worker threads (`None`: rayon's default).
     pub threads: Option<usize>,
-    /// Keep `ok` points of an existing `points.jsonl`.
+    /// Continue the run recorded in the folder (the same spec, part and build), keeping its
+    /// `ok` points.
     pub resume: bool,
+    /// Replace the run recorded in the folder (its files are moved to
+    /// [`folder::PREVIOUS_DIR`] until the first chunk of records is written).
+    pub overwrite: bool,
     /// Progress display.
     pub progress: ProgressMode,
 }
@@ -237,28 +267,38 @@ pub struct SweepOutcome {
 #[derive(Serialize)]
 struct Manifest<'a> {
     spec: &'a SweepSpec,
-    whirlmap_version: &'static str,
+    /// [`crate::shard::spec_hash`] of `spec`.
+    spec_hash: &'a str,
+    whirlmap_version: &'a str,
     model_version: u32,
-    git_commit: Option<String>,
+    /// The commit the binary that ran the drops was built from
+    /// ([`crate::build_info::GIT_COMMIT`]).
+    git_commit: &'a str,
+    /// False while the run is going on (or after it was killed); true once every file is
+    /// written.
+    complete: bool,
     started_unix_s: f64,
-    ended_unix_s: f64,
+    ended_unix_s: Option<f64>,
     threads: usize,
-    counts: Counts,
-    classes: &'a BTreeMap<String, usize>,
+    counts: Option<&'a Counts>,
+    classes: Option<&'a BTreeMap<String, usize>>,
     /// A shard run's part of the grid (`crate::shard`); absent for a whole run.
     #[serde(skip_serializing_if = "Option::is_none")]
-    shard: Option<Value>,
+    shard: Option<&'a Value>,
     /// The shards a merged result was made from (`crate::merge`); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
-    merged_from: Option<Value>,
+    merged_from: Option<&'a Value>,
+    /// Every file the run wrote (relative path -> size and FNV-1a 64 hash).
+    files: &'a BTreeMap<String, FileEntry>,
 }
 
-#[derive(Serialize)]
-struct Counts {
-    points: usize,
-    ok: usize,
-    failed: usize,
-    skipped: usize,
+/// The counts of a finished grid.
+#[derive(Debug, Clone, Serialize)]
+pub(crate) struct Counts {
+    pub points: usize,
+    pub ok: usize,
+    pub failed: usize,
+    pub skipped: usize,
 }
 
 pub(crate) fn unix_now() -> f64 {
@@ -266,19 +306,6 @@ pub(crate) fn unix_now() -> f64 {
         .duration_since(UNIX_EPOCH)
         .map(|d| d.as_secs_f64())
         .unwrap_or(0.0)
-}
-
-pub(crate) fn git_commit() -> Option<String> {
-    let out = std::process::Command::new("git")
-        .args(["rev-parse", "HEAD"])
-        .stderr(std::process::Stdio::null())
-        .output()
-        .ok()?;
-    if !out.status.success() {
-        return None;
-    }
-    let s = String::from_utf8(out.stdout).ok()?.trim().to_string();
-    (!s.is_empty()).then_some(s)
 }
 
 /// Progress reporting: an indicatif bar on a terminal, else a plain line every ~5 s.
@@ -295,6 +322,12 @@ struct Progress {
 }
 
 const PLAIN_EVERY: Duration = Duration::from_secs(5);
+
+/// Writes a progress line to standard error; a closed standard error is ignored (progress is
+/// not the result, and `eprintln!` would panic).
+pub fn progress_line(line: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
+}
 
 impl Progress {
     fn new(name: &str, total: usize, already: usize, mode: ProgressMode) -> Self {
@@ -346,7 +379,7 @@ impl Progress {
             let mut last = self.last_line.lock().unwrap_or_else(|e| e.into_inner());
             if last.elapsed() >= PLAIN_EVERY {
                 *last = Instant::now();
-                eprintln!("{}", self.line());
+                progress_line(&self.line());
             }
         }
     }
@@ -372,13 +405,14 @@ impl Progress {
             b.finish_and_clear();
         }
         if self.plain && self.start.elapsed() >= PLAIN_EVERY {
-            eprintln!("{}", self.line());
+            progress_line(&self.line());
         }
     }
 }
 
-/// A recorded line of an existing `points.jsonl`: its status and its text.
+/// A recorded line of an existing `points.jsonl`: its grid index, status and text.
 struct Existing {
+    index: Option<u64>,
     ok: bool,
     line: String,
 }
@@ -415,6 +449,7 @@ fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
         map.insert(
             key.to_string(),
             Existing {
+                index: v.get("index").and_then(Value::as_u64),
                 ok: status == "ok",
                 line: text.to_string(),
             },
@@ -461,109 +496,243 @@ const SUMMARY_FIELDS: &[&str] = &[
     "end_time_s",
 ];
 
-fn write_summary(path: &Path, points: &[Point], lines: &[Value]) -> Result<(), SweepError> {
-    let mut out = String::new();
-    let mut header = vec!["index".to_string()];
-    if let Some(p) = points.first() {
-        header.extend(p.inputs.iter().map(|(k, _)| csv_field(k)));
-    }
-    header.extend(SUMMARY_FIELDS.iter().map(|s| s.to_string()));
-    header.extend(["status".to_string(), "error".to_string()]);
-    out.push_str(&header.join(","));
-    out.push('\n');
-    for (p, v) in points.iter().zip(lines) {
-        let mut row = vec![p.index.to_string()];
-        row.extend(
-            p.inputs
-                .iter()
-                .map(|(_, x)| json_cell(Some(&Value::from(*x)))),
-        );
-        let rec = v.get("record");
-        for f in SUMMARY_FIELDS {
-            row.push(json_cell(rec.and_then(|r| r.get(*f))));
-        }
-        row.push(json_cell(v.get("status")));
-        row.push(json_cell(v.get("error").and_then(|e| e.get("message"))));
-        out.push_str(&row.join(","));
-        out.push('\n');
-    }
-    std::fs::write(path, out).map_err(io_err(path))
+/// What the summary needs of a record line.
+#[derive(serde::Deserialize)]
+struct SummaryLine {
+    #[serde(default)]
+    status: Option<String>,
+    #[serde(default)]
+    record: Option<serde_json::Map<String, Value>>,
+    #[serde(default)]
+    error: Option<Value>,
 }
 
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, bytes).map_err(io_err(&tmp))?;
-    std::fs::rename(&tmp, path).map_err(io_err(path))
+/// Reads `points.jsonl` (one line per grid point in `indices`' order) and writes
+/// `summary.csv` from it, line by line. Returns (ok, failed, class counts).
+pub(crate) fn write_summary(
+    spec: &SweepSpec,
+    out: &Path,
+    indices: &mut dyn Iterator<Item = usize>,
+) -> Result<(usize, usize, BTreeMap<String, usize>), SweepError> {
+    let points_path = out.join(POINTS_FILE);
+    let summary_path = out.join(SUMMARY_FILE);
+    let file = std::fs::File::open(&points_path).map_err(io_err(&points_path))?;
+    let mut lines = std::io::BufReader::new(file).lines();
+    let mut classes = BTreeMap::new();
+    let (mut ok, mut failed) = (0, 0);
+    let mut read_error: Option<std::io::Error> = None;
+    folder::write_atomic_with(&summary_path, |w| {
+        let mut header = vec!["index".to_string()];
+        header.extend(spec.axes.0.iter().map(|a| csv_field(&a.name)));
+        header.extend(SUMMARY_FIELDS.iter().map(|s| s.to_string()));
+        header.extend(["status".to_string(), "error".to_string()]);
+        writeln!(w, "{}", header.join(","))?;
+        for index in indices {
+            let line = match lines.next() {
+                Some(Ok(l)) => l,
+                Some(Err(e)) => {
+                    read_error = Some(e);
+                    break;
+                }
+                None => String::new(),
+            };
+            let v: Option<SummaryLine> = serde_json::from_str(&line).ok();
+            let mut row = vec![index.to_string()];
+            row.extend(
+                spec.inputs_at(index)
+                    .iter()
+                    .map(|(_, x)| json_cell(Some(&Value::from(*x)))),
+            );
+            let rec = v.as_ref().and_then(|v| v.record.as_ref());
+            for f in SUMMARY_FIELDS {
+                row.push(json_cell(rec.and_then(|r| r.get(*f))));
+            }
+            let status = v.as_ref().and_then(|v| v.status.clone());
+            if status.as_deref() == Some("ok") {
+                ok += 1;
+                if let Some(c) = rec.and_then(|r| r.get("class")).and_then(Value::as_str) {
+                    *classes.entry(c.to_string()).or_insert(0) += 1;
+                }
+            } else {
+                failed += 1;
+            }
+            row.push(json_cell(status.map(Value::from).as_ref()));
+            row.push(json_cell(
+                v.as_ref()
+                    .and_then(|v| v.error.as_ref())
+                    .and_then(|e| e.get("message")),
+            ));
+            writeln!(w, "{}", row.join(","))?;
+        }
+        Ok(())
+    })?;
+    if let Some(e) = read_error {
+        return Err(io_err(&points_path)(e));
+    }
+    Ok((ok, failed, classes))
 }
 
 /// Run facts for the manifest beside the spec and the counts.
+#[derive(Debug, Clone)]
 pub(crate) struct RunMeta {
-    pub git_commit: Option<String>,
+    /// The whirlmap version of the binary that ran the drops.
+    pub whirlmap_version: String,
+    /// Its commit.
+    pub git_commit: String,
     pub started_unix_s: f64,
-    pub ended_unix_s: f64,
+    pub ended_unix_s: Option<f64>,
     pub threads: usize,
-    pub skipped: usize,
     pub shard: Option<Value>,
     pub merged_from: Option<Value>,
 }
 
-/// Writes `summary.csv` and `manifest.json` for `points` whose `points.jsonl` lines are
-/// `lines` (same order; an empty line for a point without a record). Returns (ok, failed,
-/// class counts).
-pub(crate) fn write_summary_and_manifest(
-    spec: &SweepSpec,
-    out: &Path,
-    points: &[Point],
-    lines: &[&str],
-    meta: RunMeta,
-) -> Result<(usize, usize, BTreeMap<String, usize>), SweepError> {
-    let values: Vec<Value> = lines
-        .iter()
-        .map(|l| serde_json::from_str(l).unwrap_or(Value::Null))
-        .collect();
-    let mut classes = BTreeMap::new();
-    let mut ok = 0;
-    for v in &values {
-        if v.get("status").and_then(Value::as_str) == Some("ok") {
-            ok += 1;
-            if let Some(c) = v
-                .get("record")
-                .and_then(|r| r.get("class"))
-                .and_then(Value::as_str)
-            {
-                *classes.entry(c.to_string()).or_insert(0) += 1;
-            }
+impl RunMeta {
+    /// This binary's build, started now.
+    pub fn now(threads: usize, shard: Option<Value>) -> Self {
+        Self {
+            whirlmap_version: crate::build_info::VERSION.to_string(),
+            git_commit: crate::build_info::GIT_COMMIT.to_string(),
+            started_unix_s: unix_now(),
+            ended_unix_s: None,
+            threads,
+            shard,
+            merged_from: None,
         }
     }
-    let failed = points.len() - ok;
-    write_summary(&out.join(SUMMARY_FILE), points, &values)?;
-    let manifest = Manifest {
-        spec,
-        whirlmap_version: env!("CARGO_PKG_VERSION"),
-        model_version: MODEL_VERSION,
-        git_commit: meta.git_commit,
-        started_unix_s: meta.started_unix_s,
-        ended_unix_s: meta.ended_unix_s,
-        threads: meta.threads,
-        counts: Counts {
-            points: points.len(),
-            ok,
-            failed,
-            skipped: meta.skipped,
-        },
-        classes: &classes,
-        shard: meta.shard,
-        merged_from: meta.merged_from,
-    };
-    let text = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
-    write_atomic(&out.join(MANIFEST_FILE), format!("{text}\n").as_bytes())?;
-    Ok((ok, failed, classes))
 }
 
-/// Runs the sweep and writes its outputs. Failed points are recorded, not errors; errors
-/// are an unusable spec or output folder (before anything runs) or an I/O failure.
-pub fn run_sweep(spec: &SweepSpec, opts: &RunOptions) -> Result<SweepOutcome, SweepError> {
-    run_sweep_part(spec, opts, None)
+/// The manifest of a run being written: what `manifest.json` is made of.
+#[derive(Debug)]
+pub struct RunRecord {
+    pub(crate) spec: SweepSpec,
+    pub(crate) spec_hash: String,
+    pub(crate) meta: RunMeta,
+    pub(crate) counts: Option<Counts>,
+    pub(crate) classes: Option<BTreeMap<String, usize>>,
+}
+
+/// Writes `manifest.json` for the run `r` in `folder`, complete or not.
+pub(crate) fn write_manifest(
+    folder: &RunFolder,
+    r: &RunRecord,
+    complete: bool,
+) -> Result<(), SweepError> {
+    let manifest = Manifest {
+        spec: &r.spec,
+        spec_hash: &r.spec_hash,
+        whirlmap_version: &r.meta.whirlmap_version,
+        model_version: MODEL_VERSION,
+        git_commit: &r.meta.git_commit,
+        complete,
+        started_unix_s: r.meta.started_unix_s,
+        ended_unix_s: r.meta.ended_unix_s,
+        threads: r.meta.threads,
+        counts: r.counts.as_ref(),
+        classes: r.classes.as_ref(),
+        shard: r.meta.shard.as_ref(),
+        merged_from: r.meta.merged_from.as_ref(),
+        files: folder.files(),
+    };
+    let text = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
+    folder::write_atomic(
+        &folder.dir().join(MANIFEST_FILE),
+        format!("{text}\n").as_bytes(),
+    )
+}
+
+/// A sweep run in progress: the folder it owns and the manifest it keeps up to date. The
+/// grid is done when [`run_sweep`] returns it; the extras ([`crate::extras`]) and the charts
+/// are recorded with [`SweepRun::record`], and [`SweepRun::finish`] marks it complete.
+#[derive(Debug)]
+pub struct SweepRun {
+    /// What the grid gave.
+    pub outcome: SweepOutcome,
+    /// The folder, locked while this value lives.
+    pub folder: RunFolder,
+    pub(crate) record: RunRecord,
+}
+
+impl SweepRun {
+    /// Lists the file or folder `path` (written by the run) in the manifest, and rewrites
+    /// the manifest (still incomplete).
+    pub fn record(&mut self, path: &Path) -> Result<(), SweepError> {
+        self.folder.record_path(path)?;
+        write_manifest(&self.folder, &self.record, false)
+    }
+
+    /// Marks the run complete: the manifest, with its end time, says every file is written.
+    /// The lock is released when this returns.
+    pub fn finish(mut self) -> Result<(), SweepError> {
+        self.record.meta.ended_unix_s = Some(unix_now());
+        write_manifest(&self.folder, &self.record, true)
+    }
+}
+
+/// Runs the sweep's grid and writes its records, summary and manifest (not yet complete:
+/// the caller adds the extras and charts, then [`SweepRun::finish`]). Failed points are
+/// recorded, not errors; errors are an unusable spec or output folder (before anything runs)
+/// or an I/O failure.
+pub fn run_sweep(spec: &SweepSpec, opts: &RunOptions) -> Result<SweepRun, SweepError> {
+    let mut run = start_run(spec, opts, None)?;
+    run_grid(spec, opts, None, &mut run)?;
+    Ok(run)
+}
+
+/// The mode of a run from its options.
+fn mode(opts: &RunOptions) -> Mode {
+    if opts.resume {
+        Mode::Resume
+    } else if opts.overwrite {
+        Mode::Overwrite
+    } else {
+        Mode::Fresh
+    }
+}
+
+/// Validates the spec and every grid point, takes the output folder (lock, earlier files as
+/// `opts` says) and writes the starting manifest. Nothing has run when this returns.
+pub fn start_run(
+    spec: &SweepSpec,
+    opts: &RunOptions,
+    shard: Option<&crate::shard::Shard>,
+) -> Result<SweepRun, SweepError> {
+    spec.check_points()?;
+    let threads = match opts.threads {
+        Some(n) => n,
+        None => rayon::current_num_threads(),
+    };
+    let spec_hash = crate::shard::spec_hash(spec);
+    let tag = shard.map(|s| s.manifest_tag());
+    let id = RunIdentity {
+        spec,
+        spec_hash: spec_hash.clone(),
+        shard: tag.clone(),
+    };
+    let what = match shard {
+        Some(s) => format!("sweep --shard {} --shards {}", s.index, s.count),
+        None => "sweep".to_string(),
+    };
+    let (folder, _found) = RunFolder::prepare(&opts.out_dir, &what, &id, mode(opts))?;
+    let record = RunRecord {
+        spec: spec.clone(),
+        spec_hash,
+        meta: RunMeta::now(threads, tag),
+        counts: None,
+        classes: None,
+    };
+    write_manifest(&folder, &record, false)?;
+    Ok(SweepRun {
+        outcome: SweepOutcome {
+            points: 0,
+            ok: 0,
+            failed: 0,
+            skipped: 0,
+            classes: BTreeMap::new(),
+            out_dir: opts.out_dir.clone(),
+        },
+        folder,
+        record,
+    })
 }
 
 /// [`run_sweep`] over the grid points a shard owns (all of them for `None`); the manifest
@@ -572,14 +741,31 @@ pub fn run_sweep_part(
     spec: &SweepSpec,
     opts: &RunOptions,
     shard: Option<&crate::shard::Shard>,
-) -> Result<SweepOutcome, SweepError> {
-    let started = unix_now();
-    let mut points = spec.points()?;
-    if let Some(sh) = shard {
-        points.retain(|p| sh.owns(p.index));
+) -> Result<SweepRun, SweepError> {
+    let mut run = start_run(spec, opts, shard)?;
+    run_grid(spec, opts, shard, &mut run)?;
+    Ok(run)
+}
+
+/// The grid indices a run owns, in order.
+fn owned_indices(
+    len: usize,
+    shard: Option<&crate::shard::Shard>,
+) -> Box<dyn Iterator<Item = usize> + '_> {
+    match shard {
+        Some(s) => Box::new((s.index..len).step_by(s.count)),
+        None => Box::new(0..len),
     }
-    let out = &opts.out_dir;
-    check_output_dir(out)?;
+}
+
+/// Runs the owned grid points of `run`'s folder (see [`run_sweep`]).
+pub fn run_grid(
+    spec: &SweepSpec,
+    opts: &RunOptions,
+    shard: Option<&crate::shard::Shard>,
+    run: &mut SweepRun,
+) -> Result<(), SweepError> {
+    let grid: Grid = spec.grid()?;
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(n) = opts.threads {
         builder = builder.num_threads(n);
@@ -588,50 +774,73 @@ pub fn run_sweep_part(
         .build()
         .map_err(|e| SweepError::ThreadPool(e.to_string()))?;
     let threads = pool.current_num_threads();
-
+    run.record.meta.threads = threads;
+    let out = opts.out_dir.clone();
     let points_path = out.join(POINTS_FILE);
     let timings_path = out.join(TIMINGS_FILE);
-    let mut existing = if opts.resume {
+    let resume = opts.resume;
+    let mut existing = if resume {
         read_existing(&points_path)?
     } else {
         HashMap::new()
     };
-    let keys: Vec<String> = points
-        .iter()
-        .map(|p| point_key(&p.scene, spec.duration_s))
-        .collect();
-    let todo: Vec<&Point> = points
-        .iter()
-        .zip(&keys)
-        .filter(|(_, k)| !existing.get(*k).is_some_and(|e| e.ok))
-        .map(|(p, _)| p)
-        .collect();
-    let skipped = points.len() - todo.len();
+    let total = owned_indices(grid.len(), shard).count();
+    // A record counts for a point only at the point's own grid index.
+    let done = |p: &Point, key: &str, existing: &HashMap<String, Existing>| {
+        existing
+            .get(key)
+            .is_some_and(|e| e.ok && e.index == Some(p.index as u64))
+    };
+    let mut skipped = 0;
+    if resume {
+        for index in owned_indices(grid.len(), shard) {
+            let p = grid.point(index)?;
+            if done(&p, &point_key(&p.scene, spec.duration_s), &existing) {
+                skipped += 1;
+            }
+        }
+    }
 
     let mut points_file = OpenOptions::new()
         .create(true)
-        .append(opts.resume)
+        .append(resume)
         .write(true)
-        .truncate(!opts.resume)
+        .truncate(!resume)
         .open(&points_path)
         .map_err(io_err(&points_path))?;
-    if opts.resume {
+    if resume {
         points_file
             .seek(SeekFrom::End(0))
             .map_err(io_err(&points_path))?;
     }
     let mut timings_file = OpenOptions::new()
         .create(true)
-        .append(opts.resume)
+        .append(resume)
         .write(true)
-        .truncate(!opts.resume)
+        .truncate(!resume)
         .open(&timings_path)
         .map_err(io_err(&timings_path))?;
 
-    let progress = Progress::new(&spec.name, points.len(), skipped, opts.progress);
+    let progress = Progress::new(&spec.name, total, skipped, opts.progress);
     let chunk = (4 * threads).max(1);
     let duration = spec.duration_s;
-    for batch in todo.chunks(chunk) {
+    let mut indices = owned_indices(grid.len(), shard).peekable();
+    while indices.peek().is_some() {
+        // The next chunk of points still to run, built from their indices.
+        let mut batch: Vec<Point> = Vec::with_capacity(chunk);
+        for index in indices.by_ref() {
+            let p = grid.point(index)?;
+            if resume && done(&p, &point_key(&p.scene, duration), &existing) {
+                continue;
+            }
+            batch.push(p);
+            if batch.len() == chunk {
+                break;
+            }
+        }
+        if batch.is_empty() {
+            break;
+        }
         let records: Vec<PointRecord> = pool.install(|| {
             batch
                 .par_iter()
@@ -642,63 +851,88 @@ pub fn run_sweep_part(
                 })
                 .collect()
         });
+        let mut text = String::new();
+        let mut times = String::new();
         for r in &records {
             let line = r.to_line();
-            points_file
-                .write_all(format!("{line}\n").as_bytes())
-                .map_err(io_err(&points_path))?;
+            text.push_str(&line);
+            text.push('\n');
             let t =
                 serde_json::json!({"key": r.key, "index": r.index, "wall_time_s": r.wall_time_s});
-            timings_file
-                .write_all(format!("{t}\n").as_bytes())
-                .map_err(io_err(&timings_path))?;
-            existing.insert(
-                r.key.clone(),
-                Existing {
-                    ok: r.status == Status::Ok,
-                    line,
-                },
-            );
+            times.push_str(&format!("{t}\n"));
+            if resume {
+                existing.insert(
+                    r.key.clone(),
+                    Existing {
+                        index: Some(r.index as u64),
+                        ok: r.status == Status::Ok,
+                        line,
+                    },
+                );
+            }
         }
-        points_file.flush().map_err(io_err(&points_path))?;
-        timings_file.flush().map_err(io_err(&timings_path))?;
+        // The chunk's lines, flushed and synced: a power loss keeps every chunk before the
+        // one in flight.
+        points_file
+            .write_all(text.as_bytes())
+            .and_then(|_| points_file.flush())
+            .and_then(|_| points_file.sync_data())
+            .map_err(io_err(&points_path))?;
+        timings_file
+            .write_all(times.as_bytes())
+            .and_then(|_| timings_file.flush())
+            .map_err(io_err(&timings_path))?;
+        run.folder.release_previous()?;
     }
     progress.finish();
     drop(points_file);
     drop(timings_file);
+    run.folder.release_previous()?;
 
     // One line per point in grid order.
-    let lines: Vec<&str> = keys
-        .iter()
-        .map(|k| existing.get(k).map(|e| e.line.as_str()).unwrap_or(""))
-        .collect();
-    if opts.resume {
-        let mut text = String::new();
-        for l in &lines {
-            text.push_str(l);
-            text.push('\n');
+    if resume {
+        let mut missing = None;
+        folder::write_atomic_with(&points_path, |w| {
+            for index in owned_indices(grid.len(), shard) {
+                let line = match grid.point(index) {
+                    Ok(p) => existing
+                        .get(&point_key(&p.scene, duration))
+                        .filter(|e| e.index == Some(index as u64))
+                        .map(|e| e.line.as_str()),
+                    Err(e) => {
+                        missing = Some(e);
+                        None
+                    }
+                };
+                writeln!(w, "{}", line.unwrap_or(""))?;
+            }
+            Ok(())
+        })?;
+        if let Some(e) = missing {
+            return Err(e.into());
         }
-        write_atomic(&points_path, text.as_bytes())?;
     }
-
-    let meta = RunMeta {
-        git_commit: git_commit(),
-        started_unix_s: started,
-        ended_unix_s: unix_now(),
-        threads,
+    let (ok, failed, classes) = write_summary(spec, &out, &mut owned_indices(grid.len(), shard))?;
+    run.folder.record(POINTS_FILE)?;
+    run.folder.record(TIMINGS_FILE)?;
+    run.folder.record(SUMMARY_FILE)?;
+    run.record.counts = Some(Counts {
+        points: total,
+        ok,
+        failed,
         skipped,
-        shard: shard.map(|s| s.manifest_tag()),
-        merged_from: None,
-    };
-    let (ok, failed, classes) = write_summary_and_manifest(spec, out, &points, &lines, meta)?;
-    Ok(SweepOutcome {
-        points: points.len(),
+    });
+    run.record.classes = Some(classes.clone());
+    write_manifest(&run.folder, &run.record, false)?;
+    run.outcome = SweepOutcome {
+        points: total,
         ok,
         failed,
         skipped,
         classes,
-        out_dir: out.clone(),
-    })
+        out_dir: out,
+    };
+    Ok(())
 }
 
 #[cfg(test)]

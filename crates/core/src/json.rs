@@ -1,0 +1,97 @@
+//! Reading user JSON strictly.
+//!
+//! serde's derived structs accept a JSON list as well as an object and read the list by
+//! position: a scene file `[1000, 0.1]` would set the first two fields (`speed_rpm`,
+//! `mu_dynamic`), and `--set 'thermal=[0.5]'` the thermal model's first field. Nothing about
+//! that is intended. [`check_objects`] finds every place where the input holds a list and
+//! the parsed value is a struct (or a struct variant), and [`from_str`] parses with that
+//! check, so such input is refused with its path.
+
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use serde_json::Value;
+
+/// Refuses `given` (the input as JSON) where it holds a list at a place that `parsed` (the
+/// value serde made of it) serialises as an object: a struct read by position. The error
+/// names the place (`thermal`, `critical.speed_rpm`, or the top level) and shows the list.
+pub fn check_objects<T: Serialize>(given: &Value, parsed: &T) -> Result<(), String> {
+    let shape = serde_json::to_value(parsed).map_err(|e| e.to_string())?;
+    walk(given, &shape, "")
+}
+
+fn walk(given: &Value, shape: &Value, path: &str) -> Result<(), String> {
+    match (given, shape) {
+        (Value::Array(items), Value::Object(_)) => {
+            let mut shown = Value::Array(items.clone()).to_string();
+            if shown.len() > 60 {
+                shown.truncate(57);
+                shown.push_str("...");
+            }
+            let place = if path.is_empty() {
+                "the top level".to_string()
+            } else {
+                format!("`{path}`")
+            };
+            Err(format!(
+                "{place} must be a JSON object {{\"name\": value, ...}}, not a list ({shown}): \
+                 a list would be read by position"
+            ))
+        }
+        (Value::Object(g), Value::Object(s)) => {
+            for (k, v) in g {
+                if let Some(sv) = s.get(k) {
+                    let p = if path.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{path}.{k}")
+                    };
+                    walk(v, sv, &p)?;
+                }
+            }
+            Ok(())
+        }
+        (Value::Array(g), Value::Array(s)) => {
+            for (i, (gv, sv)) in g.iter().zip(s).enumerate() {
+                walk(gv, sv, &format!("{path}[{i}]"))?;
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Parses `text` as a `T` (serde's errors keep their line and column), then refuses a list
+/// wherever `T` has a struct ([`check_objects`]).
+pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, serde_json::Error> {
+    let parsed: T = serde_json::from_str(text)?;
+    let given: Value = serde_json::from_str(text)?;
+    check_objects(&given, &parsed).map_err(<serde_json::Error as serde::de::Error>::custom)?;
+    Ok(parsed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Scene;
+
+    #[test]
+    fn lists_for_structs_are_refused_with_their_path_and_arrays_pass() {
+        let e = from_str::<Scene>("[1000, 0.1]").unwrap_err().to_string();
+        assert!(e.contains("top level") && e.contains("[1000,0.1]"), "{e}");
+        let e = from_str::<Scene>(r#"{"thermal": [0.5]}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`thermal`") && e.contains("not a list"), "{e}");
+        let e = from_str::<Scene>(r#"{"friction_law": {"regularised": [0.01]}}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`friction_law.regularised`"), "{e}");
+        // Fields that are lists stay lists.
+        let s = from_str::<Scene>(r#"{"release_offset_m": [1e-5, 0], "speed_rpm": 1000}"#).unwrap();
+        assert_eq!(s.release_offset_m, [1e-5, 0.0]);
+        assert_eq!(s.speed_rpm, 1000.0);
+        // serde alone reads the list by position: the reason for the check.
+        let by_position: Scene = serde_json::from_str("[1000, 0.1]").unwrap();
+        assert_eq!(by_position.speed_rpm, 1000.0);
+    }
+}

@@ -1,0 +1,944 @@
+//! A results folder as a record: one writer at a time, every file listed in its manifest, and
+//! readers that refuse what the run did not write.
+//!
+//! ## The lock
+//! A run (sweep, shard, merge) and `render` hold an advisory lock ([`std::fs::File::try_lock`])
+//! on [`LOCK_FILE`] in the folder for as long as they write it. A second writer is refused
+//! (exit 2) with the holder's process id and command. The operating system drops the lock
+//! when the process ends, however it ends, so a `kill -9` never leaves a stale lock. The lock
+//! file stays in the folder (deleting it would let two processes lock two different files).
+//!
+//! ## What a run owns
+//! Every name in [`OWNED`] is whirlmap's. A new run into a folder that holds any of them is
+//! refused (exit 2) unless it is told `--resume` (the same spec and build: the records are
+//! kept, every derived file is removed and made again) or `--overwrite` (the old files are
+//! moved into [`PREVIOUS_DIR`] and deleted once the new run's first chunk of records is on
+//! disk, so a rerun killed early loses nothing). Other files are left alone and never read.
+//!
+//! ## The manifest's file list
+//! `manifest.json` is written when a run starts (`complete: false`) and rewritten after each
+//! stage; it holds the spec, its hash ([`crate::shard::spec_hash`]), the build, and `files`:
+//! every file the run wrote with its size and FNV-1a 64 hash. `complete` turns true when the
+//! last stage is written. A reader ([`check_inputs`]) accepts a derived file (`critical.json`,
+//! `orbits/`, `probability/`, `points.jsonl` of a finished run) only when the manifest lists
+//! it with that size and hash: a file from an earlier spec, copied in or edited afterwards,
+//! is refused, naming the file. In a run that did not finish, a file not yet listed is read
+//! with a warning (the run started from a folder without another run's files). Folders
+//! without a manifest, or with one from an earlier whirlmap that has no file list, are read
+//! as before with a warning that they cannot be checked.
+
+use crate::spec::SweepSpec;
+use crate::sweep::{io_err, SweepError, MANIFEST_FILE, POINTS_FILE, TIMINGS_FILE};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::fs::{File, OpenOptions, TryLockError};
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use whirlmap_core::scene::fnv1a64;
+
+/// The lock file of a results folder (see the module docs).
+pub const LOCK_FILE: &str = ".whirlmap.lock";
+
+/// Where `--overwrite` moves the previous run's files until the new run's first chunk of
+/// records is written.
+pub const PREVIOUS_DIR: &str = "previous-run";
+
+/// The names whirlmap writes into a results folder (files and folders).
+pub const OWNED: &[&str] = &[
+    POINTS_FILE,
+    TIMINGS_FILE,
+    crate::sweep::SUMMARY_FILE,
+    MANIFEST_FILE,
+    crate::extras::CRITICAL_FILE,
+    crate::extras::CRITICAL_CSV_FILE,
+    "orbits",
+    "charts",
+    crate::extras::PROBABILITY_DIR,
+    crate::shard::SHARD_FILE,
+    "compare.md",
+    "compare-classes.png",
+    PREVIOUS_DIR,
+];
+
+/// The derived names a `--resume` removes before it makes them again.
+const DERIVED: &[&str] = &[
+    crate::sweep::SUMMARY_FILE,
+    crate::extras::CRITICAL_FILE,
+    crate::extras::CRITICAL_CSV_FILE,
+    "orbits",
+    "charts",
+    crate::extras::PROBABILITY_DIR,
+    "compare.md",
+    "compare-classes.png",
+];
+
+/// The suffix of a file being written ([`write_atomic`]); one left behind by a killed run is
+/// removed by the next run that takes the lock.
+const TMP_SUFFIX: &str = ".whirlmap-tmp";
+
+/// Whether an I/O error is a failure of the storage (disk full, quota, an I/O error: exit 4)
+/// rather than a bad output path (a file in the way, no permission, a read-only file
+/// system: exit 2).
+pub fn is_storage_error(e: &std::io::Error) -> bool {
+    use std::io::ErrorKind as K;
+    !matches!(
+        e.kind(),
+        K::NotFound
+            | K::PermissionDenied
+            | K::AlreadyExists
+            | K::NotADirectory
+            | K::IsADirectory
+            | K::ReadOnlyFilesystem
+            | K::InvalidFilename
+            | K::InvalidInput
+    )
+}
+
+/// An advisory lock on a results folder, held until dropped (or the process ends).
+#[derive(Debug)]
+pub struct FolderLock {
+    _file: File,
+}
+
+impl FolderLock {
+    /// Takes the lock of `dir` (which must exist) for `what` (the command, for the message a
+    /// second writer gets). Refused (exit 2) when another process holds it.
+    pub fn acquire(dir: &Path, what: &str) -> Result<Self, SweepError> {
+        let path = dir.join(LOCK_FILE);
+        let mut file = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(|source| output_error(dir, source))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(TryLockError::WouldBlock) => {
+                let mut holder = String::new();
+                let _ = file.read_to_string(&mut holder);
+                return Err(SweepError::Refused(busy_message(dir, &holder)));
+            }
+            Err(TryLockError::Error(e)) => return Err(output_error(dir, e)),
+        }
+        // Who holds it, for the message another writer gets (best effort: on a full disk
+        // even these few bytes may not fit, and the lock holds without them).
+        let _ = file.set_len(0);
+        let _ = write!(file, "pid {}: whirlmap {what}", std::process::id());
+        let _ = file.flush();
+        Ok(Self { _file: file })
+    }
+}
+
+fn busy_message(dir: &Path, holder: &str) -> String {
+    let who = holder.trim();
+    format!(
+        "{} is in use by another whirlmap ({}): one run writes a results folder at a time; \
+         wait for it to finish, or choose another --out",
+        dir.display(),
+        if who.is_empty() {
+            "a running process"
+        } else {
+            who
+        }
+    )
+}
+
+/// `Some(holder)` when another process holds the lock of `dir` (a run is writing it).
+pub fn running_writer(dir: &Path) -> Option<String> {
+    let mut file = File::open(dir.join(LOCK_FILE)).ok()?;
+    match file.try_lock_shared() {
+        Ok(()) => None,
+        Err(TryLockError::WouldBlock) => {
+            let mut holder = String::new();
+            let _ = file.read_to_string(&mut holder);
+            Some(if holder.trim().is_empty() {
+                "a running process".to_string()
+            } else {
+                holder.trim().to_string()
+            })
+        }
+        Err(TryLockError::Error(_)) => None,
+    }
+}
+
+/// The error for an output folder that cannot be created or written: bad input (exit 2) for
+/// a bad path, an I/O error (exit 4) when the storage failed.
+pub fn output_error(dir: &Path, source: std::io::Error) -> SweepError {
+    if is_storage_error(&source) {
+        SweepError::Io {
+            path: dir.to_path_buf(),
+            source,
+        }
+    } else {
+        SweepError::Spec(crate::spec::SpecError::Output {
+            path: dir.to_path_buf(),
+            source,
+        })
+    }
+}
+
+/// Writes `bytes` to `path` all or nothing: into a temporary file beside it, synced, renamed
+/// over `path`, and the folder synced. On any failure the temporary file is removed, so a
+/// full disk leaves neither a partial file nor the old one damaged.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
+    write_atomic_with(path, |f| f.write_all(bytes))
+}
+
+/// [`write_atomic`] with the content written by `fill` (for files written line by line).
+pub fn write_atomic_with(
+    path: &Path,
+    fill: impl FnOnce(&mut std::io::BufWriter<&File>) -> std::io::Result<()>,
+) -> Result<(), SweepError> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}{TMP_SUFFIX}"));
+    let result = (|| {
+        let file = File::create(&tmp)?;
+        let mut w = std::io::BufWriter::new(&file);
+        fill(&mut w)?;
+        w.flush()?;
+        drop(w);
+        file.sync_all()?;
+        Ok(())
+    })();
+    if let Err(source) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(SweepError::Io {
+            path: path.to_path_buf(),
+            source,
+        });
+    }
+    if let Err(source) = std::fs::rename(&tmp, path) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(SweepError::Io {
+            path: path.to_path_buf(),
+            source,
+        });
+    }
+    sync_dir(path.parent().unwrap_or(Path::new(".")));
+    Ok(())
+}
+
+/// Syncs a folder so a rename in it survives a power loss (best effort: not every file
+/// system can sync a folder).
+pub fn sync_dir(dir: &Path) {
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    if let Ok(d) = File::open(dir) {
+        let _ = d.sync_all();
+    }
+}
+
+/// Removes what a killed run may have left: temporary files of [`write_atomic`] and the
+/// probe files of older versions, in `dir` and its owned subfolders.
+fn remove_leftovers(dir: &Path) {
+    let mut dirs = vec![dir.to_path_buf()];
+    for sub in ["orbits", "charts", crate::extras::PROBABILITY_DIR] {
+        dirs.push(dir.join(sub));
+    }
+    for d in dirs {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if name.ends_with(TMP_SUFFIX) || name.starts_with(".whirlmap-probe-") {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+}
+
+/// One file in the manifest's list.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileEntry {
+    /// Its size in bytes.
+    pub bytes: u64,
+    /// FNV-1a 64 of its bytes, 16 hex digits.
+    pub fnv1a64: String,
+}
+
+impl FileEntry {
+    /// Reads `path` in blocks and hashes it.
+    pub fn of(path: &Path) -> std::io::Result<Self> {
+        let mut f = File::open(path)?;
+        let mut buf = vec![0u8; 1 << 16];
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut bytes = 0u64;
+        loop {
+            let n = f.read(&mut buf)?;
+            if n == 0 {
+                break;
+            }
+            bytes += n as u64;
+            for b in &buf[..n] {
+                h ^= *b as u64;
+                h = h.wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        }
+        debug_assert_eq!(fnv1a64(b""), 0xcbf2_9ce4_8422_2325);
+        Ok(Self {
+            bytes,
+            fnv1a64: format!("{h:016x}"),
+        })
+    }
+}
+
+/// How a run treats a folder that already holds results.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// Refuse a folder that holds another run's files.
+    Fresh,
+    /// Continue the run recorded there (same spec, part and build), keeping its records.
+    Resume,
+    /// Move the files there aside and start anew.
+    Overwrite,
+}
+
+/// A results folder being written by this process: the lock, the manifest's file list, and
+/// the previous run's files while they are kept.
+#[derive(Debug)]
+pub struct RunFolder {
+    dir: PathBuf,
+    _lock: FolderLock,
+    /// Relative path (`/`-separated) -> entry.
+    pub(crate) files: BTreeMap<String, FileEntry>,
+    /// The previous run's files (`--overwrite`), deleted after the first chunk.
+    previous: Option<PathBuf>,
+}
+
+/// What [`RunFolder::prepare`] found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Found {
+    /// Nothing of whirlmap's.
+    Empty,
+    /// A run of the same spec, part and build, continued (`--resume`).
+    Resumed,
+    /// Another run's files, moved to [`PREVIOUS_DIR`] (`--overwrite`).
+    MovedAside,
+}
+
+/// Who a run is, to compare with a folder's manifest on `--resume`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunIdentity<'a> {
+    /// The spec.
+    pub spec: &'a SweepSpec,
+    /// Its hash.
+    pub spec_hash: String,
+    /// The shard section of the manifest (`{"index", "count"}`), `None` for a whole run.
+    pub shard: Option<Value>,
+}
+
+impl RunFolder {
+    /// Creates `dir`, takes its lock (for `what`, the command), removes what a killed run left
+    /// behind, and deals with files of an earlier run as `mode` says (see the module docs).
+    /// Refusals are [`SweepError::Refused`] (exit 2) and say what to do.
+    pub fn prepare(
+        dir: &Path,
+        what: &str,
+        id: &RunIdentity,
+        mode: Mode,
+    ) -> Result<(Self, Found), SweepError> {
+        std::fs::create_dir_all(dir).map_err(|e| output_error(dir, e))?;
+        let lock = FolderLock::acquire(dir, what)?;
+        remove_leftovers(dir);
+        let present: Vec<&str> = OWNED
+            .iter()
+            .copied()
+            .filter(|n| dir.join(n).symlink_metadata().is_ok())
+            .collect();
+        let mut folder = Self {
+            dir: dir.to_path_buf(),
+            _lock: lock,
+            files: BTreeMap::new(),
+            previous: None,
+        };
+        if present.is_empty() {
+            return Ok((folder, Found::Empty));
+        }
+        match mode {
+            Mode::Fresh => Err(SweepError::Refused(format!(
+                "{} holds the results of another run ({}; {}): a results folder is one run's \
+                 record. Use --resume to continue that run (the same spec), --overwrite to \
+                 replace it, or choose another --out",
+                dir.display(),
+                present.join(", "),
+                describe_manifest(dir)
+            ))),
+            Mode::Resume => {
+                check_resumable(dir, id)?;
+                for name in DERIVED {
+                    remove_path(&dir.join(name))?;
+                }
+                if dir.join(PREVIOUS_DIR).exists() {
+                    folder.previous = Some(dir.join(PREVIOUS_DIR));
+                }
+                Ok((folder, Found::Resumed))
+            }
+            Mode::Overwrite => {
+                folder.move_aside(&present)?;
+                Ok((folder, Found::MovedAside))
+            }
+        }
+    }
+
+    /// The folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Moves the owned files in `present` into [`PREVIOUS_DIR`]. When an earlier overwrite
+    /// was killed before its first chunk (the folder's own points hold no complete record),
+    /// the files moved aside then are the ones worth keeping: they stay, and the current
+    /// ones are removed.
+    fn move_aside(&mut self, present: &[&str]) -> Result<(), SweepError> {
+        let prev = self.dir.join(PREVIOUS_DIR);
+        let current_has_records = std::fs::read(self.dir.join(POINTS_FILE))
+            .map(|b| b.contains(&b'\n'))
+            .unwrap_or(false);
+        if prev.exists() && !current_has_records {
+            for name in present.iter().filter(|n| **n != PREVIOUS_DIR) {
+                remove_path(&self.dir.join(name))?;
+            }
+        } else {
+            remove_path(&prev)?;
+            std::fs::create_dir(&prev).map_err(io_err(&prev))?;
+            for name in present.iter().filter(|n| **n != PREVIOUS_DIR) {
+                let from = self.dir.join(name);
+                std::fs::rename(&from, prev.join(name)).map_err(io_err(&from))?;
+            }
+        }
+        sync_dir(&self.dir);
+        self.previous = Some(prev);
+        Ok(())
+    }
+
+    /// Deletes the previous run's files once the new run's first records are on disk.
+    pub fn release_previous(&mut self) -> Result<(), SweepError> {
+        if let Some(p) = self.previous.take() {
+            remove_path(&p)?;
+            sync_dir(&self.dir);
+        }
+        Ok(())
+    }
+
+    /// Lists the file `rel` (relative to the folder, `/`-separated) with its size and hash.
+    pub fn record(&mut self, rel: &str) -> Result<(), SweepError> {
+        let path = self.dir.join(rel);
+        let entry = FileEntry::of(&path).map_err(io_err(&path))?;
+        self.files.insert(rel.to_string(), entry);
+        Ok(())
+    }
+
+    /// Lists every file under the subfolder `rel` (nothing if it does not exist).
+    pub fn record_tree(&mut self, rel: &str) -> Result<(), SweepError> {
+        self.files
+            .retain(|k, _| !(k.starts_with(rel) && k[rel.len()..].starts_with('/')));
+        let root = self.dir.join(rel);
+        if !root.is_dir() {
+            return Ok(());
+        }
+        let mut stack = vec![root];
+        while let Some(d) = stack.pop() {
+            for e in std::fs::read_dir(&d).map_err(io_err(&d))? {
+                let p = e.map_err(io_err(&d))?.path();
+                if p.is_dir() {
+                    stack.push(p);
+                } else if let Ok(r) = p.strip_prefix(&self.dir) {
+                    let r = r
+                        .components()
+                        .map(|c| c.as_os_str().to_string_lossy())
+                        .collect::<Vec<_>>()
+                        .join("/");
+                    self.record(&r)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Lists a path the run wrote: a file or a whole subfolder (nothing for a subfolder that
+    /// does not exist).
+    pub fn record_path(&mut self, path: &Path) -> Result<(), SweepError> {
+        let rel = path.strip_prefix(&self.dir).unwrap_or(path);
+        let rel = rel
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy())
+            .collect::<Vec<_>>()
+            .join("/");
+        let full = self.dir.join(&rel);
+        if full.is_dir() || !full.exists() {
+            self.record_tree(&rel)
+        } else {
+            self.record(&rel)
+        }
+    }
+
+    /// The file list, for the manifest.
+    pub fn files(&self) -> &BTreeMap<String, FileEntry> {
+        &self.files
+    }
+}
+
+/// Removes a file or a folder tree; absent is fine.
+fn remove_path(p: &Path) -> Result<(), SweepError> {
+    let r = match p.symlink_metadata() {
+        Err(_) => return Ok(()),
+        Ok(m) if m.is_dir() => std::fs::remove_dir_all(p),
+        Ok(_) => std::fs::remove_file(p),
+    };
+    r.map_err(io_err(p))
+}
+
+/// `spec "name" (hash H), finished` or what else the manifest says, for a message.
+fn describe_manifest(dir: &Path) -> String {
+    match read_manifest(dir) {
+        Ok(Some(m)) => {
+            let name = m
+                .pointer("/spec/name")
+                .and_then(Value::as_str)
+                .unwrap_or("?");
+            let hash = m.get("spec_hash").and_then(Value::as_str);
+            let state = match m.get("complete").and_then(Value::as_bool) {
+                Some(true) => "finished",
+                Some(false) => "did not finish",
+                None => "written by an older whirlmap",
+            };
+            match hash {
+                Some(h) => format!("spec \"{name}\", hash {h}, {state}"),
+                None => format!("spec \"{name}\", {state}"),
+            }
+        }
+        Ok(None) => "no manifest.json".to_string(),
+        Err(e) => e,
+    }
+}
+
+/// The folder's `manifest.json` as JSON, `None` when there is none.
+pub fn read_manifest(dir: &Path) -> Result<Option<Value>, String> {
+    let path = dir.join(MANIFEST_FILE);
+    match std::fs::read_to_string(&path) {
+        Ok(t) => serde_json::from_str(&t)
+            .map(Some)
+            .map_err(|e| format!("{}: {e}", path.display())),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(format!("{}: {e}", path.display())),
+    }
+}
+
+/// Refuses a `--resume` unless the folder's manifest records a run of the same spec, the same
+/// part of it (whole or shard I/N) and the same build; the error says what differs.
+fn check_resumable(dir: &Path, id: &RunIdentity) -> Result<(), SweepError> {
+    let refuse = |why: String| {
+        SweepError::Refused(format!(
+            "cannot resume {}: {why}. Use --overwrite to replace it, or choose another --out",
+            dir.display()
+        ))
+    };
+    let m = match read_manifest(dir) {
+        Ok(Some(m)) => m,
+        Ok(None) => {
+            return Err(refuse(
+                "it has no manifest.json saying which spec its records belong to".into(),
+            ))
+        }
+        Err(e) => return Err(refuse(format!("its manifest is unreadable ({e})"))),
+    };
+    if m.get("complete").is_none() {
+        return Err(refuse(
+            "it was written by an older whirlmap, whose manifest names neither its build nor \
+             its files"
+                .into(),
+        ));
+    }
+    let old_shard = m.get("shard").cloned().filter(|v| !v.is_null());
+    if old_shard != id.shard {
+        let part = |v: &Option<Value>| match v {
+            Some(s) => format!(
+                "shard {}/{}",
+                s.get("index").unwrap_or(&Value::Null),
+                s.get("count").unwrap_or(&Value::Null)
+            ),
+            None => "a whole sweep".to_string(),
+        };
+        return Err(refuse(format!(
+            "it holds {} of spec {}, not {} of spec {}",
+            part(&old_shard),
+            m.get("spec_hash").and_then(Value::as_str).unwrap_or("?"),
+            part(&id.shard),
+            id.spec_hash
+        )));
+    }
+    let old_hash = m.get("spec_hash").and_then(Value::as_str).unwrap_or("?");
+    if old_hash != id.spec_hash {
+        let diffs = match manifest_spec(dir) {
+            Some(old) => spec_differences(&old, id.spec),
+            None => value_differences(
+                m.get("spec").unwrap_or(&Value::Null),
+                &serde_json::to_value(id.spec).expect("specs serialise"),
+            ),
+        };
+        return Err(refuse(format!(
+            "its records are of another spec (hash {old_hash}, this one {}): {}",
+            id.spec_hash,
+            if diffs.is_empty() {
+                "the specs differ".to_string()
+            } else {
+                diffs.join("; ")
+            }
+        )));
+    }
+    let field = |k: &str| {
+        m.get(k)
+            .map(|v| v.as_str().map(str::to_string).unwrap_or(v.to_string()))
+    };
+    let old_build = (field("whirlmap_version"), field("git_commit"));
+    let this = (
+        Some(crate::build_info::VERSION.to_string()),
+        Some(crate::build_info::GIT_COMMIT.to_string()),
+    );
+    if old_build != this {
+        return Err(refuse(format!(
+            "it was started by whirlmap {}, this is {}: records of two builds would be mixed \
+             (resume it with that build)",
+            crate::build_info::describe(
+                old_build.0.as_deref().unwrap_or("?"),
+                old_build.1.as_deref().unwrap_or("?")
+            ),
+            crate::build_info::DESCRIPTION
+        )));
+    }
+    let model = m.get("model_version").and_then(Value::as_u64);
+    if model != Some(whirlmap_core::MODEL_VERSION as u64) {
+        return Err(refuse(format!(
+            "it was run with model version {}, this whirlmap has {}",
+            model.map_or("?".to_string(), |v| v.to_string()),
+            whirlmap_core::MODEL_VERSION
+        )));
+    }
+    Ok(())
+}
+
+/// What differs between two specs as JSON, one entry per differing field path:
+/// `duration_s: 1.0 -> 0.5`, `axes.mu: [0.1,0.2] -> [0.1]`, `critical: (none) -> {...}`.
+/// Empty when they are equal. (JSON objects are compared by key, so the order of the axes is
+/// compared by [`spec_differences`].)
+pub fn value_differences(old: &Value, new: &Value) -> Vec<String> {
+    let mut out = Vec::new();
+    diff("", old, new, &mut out);
+    out
+}
+
+/// What differs between two specs ([`value_differences`]), the order of the axes included
+/// (`axes: order speed_rpm, mu -> mu, speed_rpm`: the grid's row-major order, so every
+/// index, changes with it).
+pub fn spec_differences(old: &SweepSpec, new: &SweepSpec) -> Vec<String> {
+    let names = |s: &SweepSpec| s.axes.0.iter().map(|a| a.name.clone()).collect::<Vec<_>>();
+    let (a, b) = (names(old), names(new));
+    let mut out = Vec::new();
+    let (mut sa, mut sb) = (a.clone(), b.clone());
+    sa.sort();
+    sb.sort();
+    if sa == sb && a != b {
+        out.push(format!("axes: order {} -> {}", a.join(", "), b.join(", ")));
+    }
+    out.extend(value_differences(
+        &serde_json::to_value(old).expect("specs serialise"),
+        &serde_json::to_value(new).expect("specs serialise"),
+    ));
+    out
+}
+
+/// The spec recorded in the folder's manifest, parsed from its text so the order of the axes
+/// is kept; `None` when there is no manifest or its spec does not parse.
+pub fn manifest_spec(dir: &Path) -> Option<SweepSpec> {
+    #[derive(Deserialize)]
+    struct OnlySpec {
+        spec: SweepSpec,
+    }
+    let text = std::fs::read_to_string(dir.join(MANIFEST_FILE)).ok()?;
+    serde_json::from_str::<OnlySpec>(&text).ok().map(|m| m.spec)
+}
+
+fn short(v: &Value) -> String {
+    let mut s = v.to_string();
+    if s.len() > 80 {
+        let cut = (0..=77).rev().find(|i| s.is_char_boundary(*i)).unwrap_or(0);
+        s.truncate(cut);
+        s.push_str("...");
+    }
+    s
+}
+
+fn diff(path: &str, old: &Value, new: &Value, out: &mut Vec<String>) {
+    if old == new {
+        return;
+    }
+    let name = if path.is_empty() { "spec" } else { path };
+    match (old, new) {
+        (Value::Object(a), Value::Object(b)) => {
+            for (k, va) in a {
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                match b.get(k) {
+                    Some(vb) => diff(&p, va, vb, out),
+                    None => out.push(format!("{p}: {} -> (none)", short(va))),
+                }
+            }
+            for (k, vb) in b {
+                if !a.contains_key(k) {
+                    let p = if path.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{path}.{k}")
+                    };
+                    out.push(format!("{p}: (none) -> {}", short(vb)));
+                }
+            }
+        }
+        _ => out.push(format!("{name}: {} -> {}", short(old), short(new))),
+    }
+}
+
+/// What a reader learnt about a results folder ([`check_inputs`]).
+#[derive(Debug, Clone, Default)]
+pub struct Checked {
+    /// Things to say loudly but not fatal: no manifest, an older manifest, a run that did
+    /// not finish.
+    pub warnings: Vec<String>,
+    /// The manifest, when there is one.
+    pub manifest: Option<Value>,
+    /// Whether the manifest has a file list (written by this version of whirlmap).
+    pub listed: bool,
+}
+
+impl Checked {
+    /// The spec recorded in the manifest, if any.
+    pub fn spec(&self) -> Option<&Value> {
+        self.manifest.as_ref().and_then(|m| m.get("spec"))
+    }
+    /// The spec hash recorded in the manifest, if any.
+    pub fn spec_hash(&self) -> Option<&str> {
+        self.manifest
+            .as_ref()
+            .and_then(|m| m.get("spec_hash"))
+            .and_then(Value::as_str)
+    }
+    /// Whether the manifest says the run finished (`None`: no manifest or an older one).
+    pub fn complete(&self) -> Option<bool> {
+        self.manifest
+            .as_ref()
+            .and_then(|m| m.get("complete"))
+            .and_then(Value::as_bool)
+    }
+}
+
+/// The inputs a reader (render, compare, merge) takes from a results folder: each file that
+/// exists among `points.jsonl`, `critical.json`, `orbits/*.json` and
+/// `probability/contours.json`.
+pub fn reader_inputs(dir: &Path) -> Vec<String> {
+    let mut v = Vec::new();
+    for f in [
+        POINTS_FILE.to_string(),
+        crate::extras::CRITICAL_FILE.to_string(),
+        format!(
+            "{}/{}",
+            crate::extras::PROBABILITY_DIR,
+            crate::ensemble::CONTOURS_FILE
+        ),
+    ] {
+        if dir.join(&f).is_file() {
+            v.push(f);
+        }
+    }
+    if let Ok(entries) = std::fs::read_dir(dir.join("orbits")) {
+        let mut orbits: Vec<String> = entries
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".json"))
+            .map(|n| format!("orbits/{n}"))
+            .collect();
+        orbits.sort();
+        v.extend(orbits);
+    }
+    v
+}
+
+/// Checks the files a reader is about to use (`inputs`, relative paths) against the folder's
+/// manifest (see the module docs). `Err` lists every file that is not what the run recorded;
+/// `Ok` carries warnings for folders that cannot be checked or did not finish.
+pub fn check_inputs(dir: &Path, inputs: &[String]) -> Result<Checked, Vec<String>> {
+    let manifest = read_manifest(dir).map_err(|e| vec![e])?;
+    let mut checked = Checked {
+        manifest,
+        ..Default::default()
+    };
+    let Some(m) = checked.manifest.clone() else {
+        checked.warnings.push(format!(
+            "{} has no manifest.json: its files cannot be checked against the run that wrote \
+             them",
+            dir.display()
+        ));
+        return Ok(checked);
+    };
+    let Some(files) = m.get("files").and_then(Value::as_object) else {
+        checked.warnings.push(format!(
+            "{} was written by an older whirlmap (its manifest has no file list): its files \
+             cannot be checked against the run that wrote them",
+            dir.display()
+        ));
+        return Ok(checked);
+    };
+    checked.listed = true;
+    let complete = m.get("complete").and_then(Value::as_bool) == Some(true);
+    if !complete {
+        checked.warnings.push(format!(
+            "{} holds a run that did not finish (manifest.json: complete = false): its \
+             results are partial",
+            dir.display()
+        ));
+    }
+    let name = m
+        .pointer("/spec/name")
+        .and_then(Value::as_str)
+        .unwrap_or("?");
+    let hash = m.get("spec_hash").and_then(Value::as_str).unwrap_or("?");
+    let mut problems = Vec::new();
+    for rel in inputs {
+        let path = dir.join(rel);
+        match files.get(rel) {
+            Some(listed) => {
+                let listed: Option<FileEntry> = serde_json::from_value(listed.clone()).ok();
+                match FileEntry::of(&path) {
+                    Ok(actual) if Some(&actual) == listed.as_ref() => {}
+                    Ok(_) => problems.push(format!(
+                        "{} is not the file the run of spec \"{name}\" (hash {hash}) wrote: \
+                         its size or content changed afterwards",
+                        path.display()
+                    )),
+                    Err(e) => problems.push(format!("{}: {e}", path.display())),
+                }
+            }
+            // The records of a run in progress or killed: not listed until the grid ends.
+            None if !complete && (rel == POINTS_FILE || rel == TIMINGS_FILE) => {}
+            // A run that did not finish lists a file only once its stage is done; the folder
+            // held none of another run's files when it started.
+            None if !complete => checked.warnings.push(format!(
+                "{} is not listed by the run that did not finish: it cannot be checked",
+                path.display()
+            )),
+            None => problems.push(format!(
+                "{} was not written by the run recorded in {} (spec \"{name}\", hash {hash}): \
+                 a stale file of an earlier run; remove it, or rerun the sweep with \
+                 --overwrite",
+                path.display(),
+                dir.join(MANIFEST_FILE).display()
+            )),
+        }
+    }
+    if problems.is_empty() {
+        Ok(checked)
+    } else {
+        Err(problems)
+    }
+}
+
+/// Rewrites the manifest of `dir` with the subfolder `rel` listed anew (after `render`
+/// redrew `charts/`); does nothing for a folder whose manifest has no file list.
+pub fn relist_tree(dir: &Path, rel: &str) -> Result<(), SweepError> {
+    let Ok(Some(mut m)) = read_manifest(dir) else {
+        return Ok(());
+    };
+    let Some(files) = m.get_mut("files").and_then(Value::as_object_mut) else {
+        return Ok(());
+    };
+    files.retain(|k, _| !(k.starts_with(rel) && k[rel.len()..].starts_with('/')));
+    let root = dir.join(rel);
+    let mut stack = vec![root];
+    let mut found = Vec::new();
+    while let Some(d) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                found.push(p);
+            }
+        }
+    }
+    for p in found {
+        let entry = FileEntry::of(&p).map_err(io_err(&p))?;
+        let r = p
+            .strip_prefix(dir)
+            .unwrap_or(&p)
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy())
+            .collect::<Vec<_>>()
+            .join("/");
+        files.insert(r, serde_json::to_value(entry).expect("entries serialise"));
+    }
+    // Sorted, as the run wrote it.
+    let sorted: BTreeMap<String, Value> = std::mem::take(files).into_iter().collect();
+    *files = sorted.into_iter().collect();
+    let text = serde_json::to_string_pretty(&m).expect("manifests serialise");
+    write_atomic(&dir.join(MANIFEST_FILE), format!("{text}\n").as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn spec_differences_name_each_field_and_the_axis_order() {
+        let a = crate::spec::parse(
+            r#"{"name": "x", "duration_s": 1.0, "axes": {"speed_rpm": [1000, 2000], "mu": [0.1]}}"#,
+        )
+        .unwrap();
+        let b = crate::spec::parse(
+            r#"{"name": "x", "duration_s": 0.5, "axes": {"mu": [0.1], "speed_rpm": [1000]}}"#,
+        )
+        .unwrap();
+        let d = spec_differences(&a, &b);
+        assert!(d.contains(&"duration_s: 1.0 -> 0.5".to_string()), "{d:?}");
+        assert!(
+            d.contains(&"axes: order speed_rpm, mu -> mu, speed_rpm".to_string()),
+            "{d:?}"
+        );
+        assert!(
+            d.contains(&"axes.speed_rpm: [1000.0,2000.0] -> [1000.0]".to_string()),
+            "{d:?}"
+        );
+        assert!(spec_differences(&a, &a).is_empty());
+        let v = value_differences(
+            &json!({"critical": null}),
+            &json!({"critical": {"mu": [0.3]}}),
+        );
+        assert_eq!(v, ["critical: null -> {\"mu\":[0.3]}"]);
+    }
+
+    #[test]
+    fn file_entries_hash_like_fnv1a64() {
+        let dir = std::env::temp_dir().join(format!("whirlmap-folder-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("f");
+        std::fs::write(&p, b"hello").unwrap();
+        let e = FileEntry::of(&p).unwrap();
+        assert_eq!(e.bytes, 5);
+        assert_eq!(e.fnv1a64, format!("{:016x}", fnv1a64(b"hello")));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
