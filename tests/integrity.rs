@@ -473,6 +473,8 @@ fn impossible_physics_is_refused_and_a_failed_energy_audit_fails_the_drop() {
     // failure, exit 3.
     let bad = [
         "--set",
+        "solver.method=dopri5",
+        "--set",
         "solver.rtol=1e-3",
         "--set",
         "solver.race_atol_scale=1e4",
@@ -488,13 +490,17 @@ fn impossible_physics_is_refused_and_a_failed_energy_audit_fails_the_drop() {
         "{}",
         stderr(&o)
     );
-    // The same drop with tight tolerances passes, so the audit tells the two apart.
+    // The same drop with the race's tolerance not loosened passes, so the audit tells the two apart.
     let o = whirlmap(&[
         "drop",
         "--speed-rpm",
         "0",
         "--duration-s",
         "0.2",
+        "--set",
+        "solver.method=dopri5",
+        "--set",
+        "solver.race_atol_scale=1",
         "--set",
         "classification.max_extension_s=0",
         "--json",
@@ -509,7 +515,7 @@ fn impossible_physics_is_refused_and_a_failed_energy_audit_fails_the_drop() {
         "audit",
         r#"{"name": "audit", "duration_s": 0.2,
             "scene": {"speed_rpm": 0, "classification": {"max_extension_s": 0},
-                      "solver": {"rtol": 1e-3}},
+                      "solver": {"rtol": 1e-3, "method": "dopri5"}},
             "axes": {"solver.race_atol_scale": [1, 10000]}}"#,
     );
     let out_dir = dir.join("out");
