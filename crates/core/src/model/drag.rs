@@ -57,7 +57,16 @@ impl Palmgren {
 /// `omega_eps` (a documented scene parameter, default 0.1 rad/s, about 1 r/min).
 #[inline]
 pub fn direction(omega_rad_s: f64, omega_eps_rad_s: f64) -> f64 {
-    (omega_rad_s / omega_eps_rad_s).tanh()
+    let x = omega_rad_s / omega_eps_rad_s;
+    // From |x| = 22 on, tanh is +-1 to the last bit (glibc returns exactly that there): the
+    // common case of a spinning race skips the call.
+    if x >= 22.0 {
+        1.0
+    } else if x <= -22.0 {
+        -1.0
+    } else {
+        x.tanh()
+    }
 }
 
 #[cfg(test)]
@@ -107,5 +116,10 @@ mod tests {
         assert!((direction(10.0, 0.1) - 1.0).abs() < 1e-12);
         assert!((direction(-10.0, 0.1) + 1.0).abs() < 1e-12);
         assert!((direction(1e-4, 0.1) - 1e-3).abs() < 1e-8);
+        // The shortcut beyond |x| = 22 gives tanh's own bits.
+        for x in [21.99, 22.0, 22.5, 30.0, 1e3, 1e300, f64::INFINITY] {
+            assert_eq!(direction(x, 1.0), x.tanh(), "{x}");
+            assert_eq!(direction(-x, 1.0), (-x).tanh(), "{x}");
+        }
     }
 }

@@ -116,10 +116,14 @@ impl<const N: usize> StepCore<N> {
             }
             if fixed || (err.is_finite() && err <= 1.0) {
                 if !fixed {
-                    // err_old^0 = 1 exactly, so without a PI term this is the plain law.
-                    let fac =
-                        (err.max(1e-10).powf(law.expo) / self.err_old.powf(law.beta) / law.safe)
-                            .clamp(1.0 / law.fac_max, 1.0 / law.fac_min);
+                    // err_old^0 is 1 exactly: the call is skipped without the PI term.
+                    let pi = if law.beta == 0.0 {
+                        1.0
+                    } else {
+                        self.err_old.powf(law.beta)
+                    };
+                    let fac = (err.max(1e-10).powf(law.expo) / pi / law.safe)
+                        .clamp(1.0 / law.fac_max, 1.0 / law.fac_min);
                     let mut h_new = h / fac;
                     if rejected_last {
                         h_new = h_new.min(h);

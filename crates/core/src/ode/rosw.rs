@@ -116,8 +116,26 @@ impl Lu {
             0 => (Factors::Identity, true),
             // A non-finite factor is not caught here: it makes the attempt's error norm NaN,
             // and the step controller shrinks the step.
-            6 => {
-                let mut a = Matrix6::from_fn(|a, b| self.reduced(a, b));
+            6 if k == 4 => {
+                // S = I - hg J_vv - hg^2 J_vq over the six non-kinematic components, built
+                // block by block (the general `reduced` entry by entry costs 3x more).
+                let jac = &self.j.jac;
+                let hg2 = hg * hg;
+                // The same operations in the same order as `reduced`, so the same bits.
+                let mut a = Matrix6::<f64>::zeros();
+                for b in 0..6 {
+                    for r in 0..6 {
+                        a[(r, b)] = -hg * jac[(4 + r, 4 + b)];
+                    }
+                }
+                for b in 0..4 {
+                    for r in 0..6 {
+                        a[(r, b)] -= hg2 * jac[(4 + r, b)];
+                    }
+                }
+                for d in 0..6 {
+                    a[(d, d)] += 1.0;
+                }
                 let (piv, ok) = lu6(&mut a);
                 (Factors::Six(a, piv), ok)
             }
