@@ -59,7 +59,10 @@ impl Fidelity {
         let standard = SolverSettings::default();
         match self {
             Fidelity::Draft => SolverSettings {
-                rtol: 3e-4,
+                rtol: 1e-4,
+                method: Method::Ros34pw2,
+                free_flight_gap_bound: true,
+                race_atol_scale: 1000.0,
                 ..standard
             },
             Fidelity::Standard => standard,

@@ -26,6 +26,13 @@ impl Observer<DropSystem, N> for Check {
             return ControlFlow::Continue(());
         }
         let y = step.dense.y1();
+        // A central difference with a 1e-12 m step cannot resolve the Hertz law's d^(3/2)
+        // within a few steps of first touch (measured: a 1 % mismatch at d = 1.1e-12 m, where
+        // the difference straddles d = 0): check contact states that are at least 1 nm in.
+        let d = (y[ix::XR] - y[ix::XB]).hypot(y[ix::YR] - y[ix::YB]) - sys.clearance_m();
+        if sys.mode.contact && d < 1e-9 {
+            return ControlFlow::Continue(());
+        }
         let sj = sys
             .stiff_jacobian(0.0, &y)
             .expect("the drop model supplies a Jacobian");

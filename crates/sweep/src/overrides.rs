@@ -136,9 +136,9 @@ mod tests {
         for (key, value) in [
             ("support_damper", "\"radial_only\""),
             ("release_velocity_m_s", "[0, -1e-3]"),
-            ("solver.free_flight_gap_bound", "false"),
+            ("solver.free_flight_gap_bound", "true"),
             ("solver.race_atol_scale", "100"),
-            ("solver.method", "dopri5"),
+            ("solver.method", "ros34pw2"),
         ] {
             let mut t = Scene::paper();
             apply_assignment(&mut t, &format!("{key}={value}")).unwrap();
