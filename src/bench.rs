@@ -25,7 +25,7 @@ pub struct BenchArgs {
     reps: usize,
     /// Also run the long thermal scenes (`scenes/coast-down.json` to its stop speed and for
     /// 60 s, `scenes/runaway.json` for 60 s), each with the full model and with the `draft`
-    /// fidelity (quasi-static race), and compare them (about 30 s of CPU in all).
+    /// fidelity (ROS34PW2, race tolerance x1000, rtol 1e-4), and compare them (about 30 s of CPU in all).
     #[arg(long)]
     coast_down: bool,
 }
@@ -61,7 +61,7 @@ struct Case {
 /// ratio to the baseline (the first row) and to the peer, and the work counts.
 pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
     let reps = a.reps.max(1);
-    let cases: [Case; 8] = [
+    let cases: [Case; 9] = [
         Case {
             name: "pendulum 1 s, standard (baseline)",
             speed_rpm: 8000.0,
@@ -78,6 +78,12 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             name: "pendulum 1 s, draft",
             speed_rpm: 8000.0,
             mu: 0.1,
+            edit: |s| Fidelity::Draft.apply(s),
+        },
+        Case {
+            name: "whirl, draft",
+            speed_rpm: 8000.0,
+            mu: 0.4,
             edit: |s| Fidelity::Draft.apply(s),
         },
         Case {
@@ -303,7 +309,7 @@ fn long_thermal_run(name: &str, scene: &Scene, duration_s: f64) -> anyhow::Resul
     Ok(r)
 }
 
-/// What the quasi-static race changes in what a thermal run is for: temperatures, thermal
+/// What the draft fidelity changes in what a thermal run is for: temperatures, thermal
 /// load, heat energies, end speed and time.
 fn print_thermal_differences(full: &DropReport, draft: &DropReport) {
     let (a, b) = (
@@ -350,8 +356,8 @@ fn print_thermal_differences(full: &DropReport, draft: &DropReport) {
     );
 }
 
-/// The long thermal scenes with the full model and with the draft fidelity (quasi-static
-/// race at rtol 1e-4), side by side.
+/// The long thermal scenes with the scene's own numerics and with the draft fidelity, side by
+/// side.
 fn thermal_pairs() -> anyhow::Result<()> {
     let coast: Scene = serde_json::from_str(COAST_DOWN_SCENE)?;
     let mut coast_60 = coast.clone();
