@@ -21,8 +21,9 @@
 #![allow(clippy::excessive_precision)]
 
 use super::control::{StepCore, StepLaw};
-use super::dopri5::{Dense, StepControl};
-use super::{OdeSystem, Stepper};
+use super::step::{Dense, StepControl};
+use super::stepper::Stepper;
+use super::system::OdeSystem;
 use crate::error::SolveError;
 
 /// Stages of the step (12) and of the dense output (16).

@@ -17,7 +17,9 @@
 //! stage.
 
 use super::control::{StepCore, StepLaw};
-use super::{Dense, OdeSystem, StepControl, Stepper, StiffJacobian, MAX_STIFF};
+use super::step::{Dense, StepControl};
+use super::stepper::Stepper;
+use super::system::{OdeSystem, StiffJacobian, MAX_STIFF};
 use crate::error::SolveError;
 use nalgebra::{DMatrix, DVector, Dyn, Matrix6, LU};
 
