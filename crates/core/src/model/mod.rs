@@ -12,11 +12,13 @@
 pub mod drag;
 pub mod friction;
 pub mod hertz;
+pub mod modes;
 pub mod quasi_static;
 
 use crate::ode::{OdeSystem, StiffJacobian, MAX_GUARDS};
 use crate::scene::{FrictionLaw, Scene, SupportDamper};
 pub use friction::Slip;
+pub use modes::{Guard, Mode};
 use nalgebra::{Matrix2, Vector2};
 use std::cell::RefCell;
 
@@ -56,17 +58,6 @@ pub mod ix {
 }
 /// State dimension.
 pub const N: usize = 15;
-
-/// The discrete mode: which contacts carry force and how the rotor-race contact rubs.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Mode {
-    /// Rotor-race contact active (eq. 7 force on).
-    pub contact: bool,
-    /// Race-on-balls support active (its damper never pulls either).
-    pub support: bool,
-    /// Friction state of the rotor-race contact while `contact`.
-    pub slip: Slip,
-}
 
 /// Everything the model computes at one state in one mode.
 #[derive(Debug, Clone, Copy, Default)]
@@ -490,27 +481,6 @@ impl DropSystem {
         f.acc = self.accelerations(y, f, ft, support_vec);
     }
 
-    /// The friction mode to enter at a state in contact, per eqs. 9-10: slip along the slip
-    /// velocity's sign, unless it is (numerically) zero, in which case stick if the friction
-    /// that keeps rolling is at most `mu_s F_n`, else slip along that friction's sign.
-    /// `at_zero` forces the stick test (the state sits at a located v_rel = 0 crossing).
-    pub fn entering_slip(&self, y: &[f64; N], at_zero: bool) -> Slip {
-        if !self.friction_switches() {
-            return Slip::Slipping(1.0);
-        }
-        let mode = Mode {
-            contact: true,
-            support: self.mode.support,
-            slip: Slip::Sticking,
-        };
-        let f = self.forces_in(y, mode);
-        let v_scale = 1e-9 * (1.0 + y[ix::WR].abs() * self.r_r);
-        if !at_zero && f.v_rel_m_s.abs() > v_scale {
-            return Slip::Slipping(f.v_rel_m_s.signum());
-        }
-        friction::stick_or_slip(f.friction_required_n, self.mu_s * f.normal_n.max(0.0))
-    }
-
     /// Mechanical energy (J): kinetic, gravitational (zero at y = 0) and the elastic energy
     /// of the contacts active in `mode`.
     pub fn mechanical_energy(&self, y: &[f64; N], mode: Mode) -> f64 {
@@ -549,36 +519,11 @@ impl DropSystem {
     pub fn weight_n(&self) -> f64 {
         self.f_ref
     }
-
-    /// The guards of [`OdeSystem::guards`] from the forces at the state.
-    #[inline]
-    fn guards_of(&self, f: &Forces, g: &mut [f64; MAX_GUARDS]) -> usize {
-        let c = self.contact_indicator(f);
-        g[0] = if self.mode.contact { c } else { -c };
-        let sup = f.support_raw_n / self.f_ref_b;
-        g[1] = if self.mode.support { sup } else { -sup };
-        if self.mode.contact && self.friction_switches() {
-            g[2] = match self.mode.slip {
-                Slip::Slipping(sign) => sign * f.v_rel_m_s,
-                Slip::Sticking => {
-                    (self.mu_s * f.normal_n - f.friction_required_n.abs()) / self.f_ref
-                }
-            };
-            3
-        } else {
-            2
-        }
-    }
-
-    /// Contact guard: `min(delta / s, F_raw / F_ref)`, positive exactly when eq. 7's force
-    /// is active (penetrating, and the damper not pulling). Continuous in the state.
-    #[inline]
-    fn contact_indicator(&self, f: &Forces) -> f64 {
-        (f.delta_m / self.s).min(f.normal_raw_n / self.f_ref)
-    }
 }
 
 impl OdeSystem<N> for DropSystem {
+    type Guard = Guard;
+
     fn rhs(&self, _t: f64, y: &[f64; N], dy: &mut [f64; N]) {
         dy[ix::XR] = y[ix::VXR];
         dy[ix::YR] = y[ix::VYR];

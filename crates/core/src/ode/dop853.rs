@@ -362,6 +362,7 @@ mod tests {
     /// x'' = -x; exact solution cos t.
     struct Harmonic;
     impl OdeSystem<2> for Harmonic {
+        type Guard = crate::ode::NoGuard;
         fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
             dy[0] = y[1];
             dy[1] = -y[0];

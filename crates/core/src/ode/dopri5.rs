@@ -198,6 +198,7 @@ mod tests {
     /// x'' = -x as a first-order system; exact solution cos t.
     struct Harmonic;
     impl OdeSystem<2> for Harmonic {
+        type Guard = crate::ode::NoGuard;
         fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
             dy[0] = y[1];
             dy[1] = -y[0];
@@ -207,6 +208,7 @@ mod tests {
     /// y' = -2 y; exact solution exp(-2 t).
     struct Decay;
     impl OdeSystem<1> for Decay {
+        type Guard = crate::ode::NoGuard;
         fn rhs(&self, _t: f64, y: &[f64; 1], dy: &mut [f64; 1]) {
             dy[0] = -2.0 * y[0];
         }
@@ -276,6 +278,7 @@ mod tests {
     fn non_finite_rhs_is_a_typed_error_with_time() {
         struct Blow;
         impl OdeSystem<1> for Blow {
+            type Guard = crate::ode::NoGuard;
             fn rhs(&self, t: f64, _y: &[f64; 1], dy: &mut [f64; 1]) {
                 dy[0] = if t > 0.5 { f64::NAN } else { 1.0 };
             }
@@ -302,7 +305,13 @@ mod tests {
     fn event_on_a_falling_ball_is_located_at_the_closed_form_time() {
         // y'' = -g from height 1 m: the guard y crosses zero at sqrt(2/g).
         struct Ball;
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        struct Floor;
+        impl crate::ode::GuardSet for Floor {
+            const ALL: &'static [Self] = &[Floor];
+        }
         impl OdeSystem<2> for Ball {
+            type Guard = Floor;
             fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
                 dy[0] = y[1];
                 dy[1] = -9.81;
@@ -330,7 +339,7 @@ mod tests {
         let mut st = Dopri5::new(ctl);
         let (mut t, mut y) = (0.0, [1.0, 0.0]);
         let stop = integrate(&Ball, &mut st, &mut t, &mut y, 10.0, &mut NoObserver).unwrap();
-        assert_eq!(stop, Stop::Event { index: 0 });
+        assert_eq!(stop, Stop::Event { guard: Floor });
         let exact = (2.0 / 9.81f64).sqrt();
         assert!((t - exact).abs() < 1e-12, "event at {t}, exact {exact}");
         // The run continues just past the crossing, on the new mode's side.

@@ -4,7 +4,7 @@
 use super::events::locate_crossing;
 use super::step::Dense;
 use super::stepper::Stepper;
-use super::system::{OdeSystem, MAX_GUARDS};
+use super::system::{GuardSet, OdeSystem, MAX_GUARDS};
 use crate::error::SolveError;
 use std::ops::ControlFlow;
 
@@ -14,30 +14,35 @@ pub struct StepView<'a, const N: usize> {
     pub dense: &'a Dense<N>,
 }
 
-/// Receives every accepted step; may ask the integrator to stop.
+/// Receives every accepted step; may ask the integrator to stop, and says why.
 pub trait Observer<S, const N: usize> {
+    /// Why this observer stops a run ([`std::convert::Infallible`] if it never does); the
+    /// driver hands it back in [`Stop::Halted`].
+    type Halt;
     /// Called once per accepted (possibly event-truncated) step.
-    fn on_step(&mut self, _sys: &S, _step: &StepView<'_, N>) -> ControlFlow<()> {
+    fn on_step(&mut self, _sys: &S, _step: &StepView<'_, N>) -> ControlFlow<Self::Halt> {
         ControlFlow::Continue(())
     }
 }
 
 /// An observer that does nothing.
 pub struct NoObserver;
-impl<S, const N: usize> Observer<S, N> for NoObserver {}
+impl<S, const N: usize> Observer<S, N> for NoObserver {
+    type Halt = std::convert::Infallible;
+}
 
-/// Why [`integrate`] returned.
+/// Why [`integrate`] returned: `G` is the system's guard set, `H` the observer's halt reason.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Stop {
+pub enum Stop<G, H> {
     /// The end time was reached.
     EndTime,
-    /// Guard `index` crossed to `<= 0`; the returned state is just past the crossing.
+    /// A guard crossed to `<= 0`; the returned state is just past the crossing.
     Event {
         /// Which guard of the mode fired.
-        index: usize,
+        guard: G,
     },
-    /// An observer returned `ControlFlow::Break`.
-    Observer,
+    /// The observer returned `ControlFlow::Break(halt)`.
+    Halted(H),
 }
 
 /// Integrates `sys` from `(t, y)` towards `t_end`, advancing `t` and `y` in place.
@@ -52,7 +57,7 @@ pub fn integrate<S, O, M, const N: usize>(
     y: &mut [f64; N],
     t_end: f64,
     observer: &mut O,
-) -> Result<Stop, SolveError>
+) -> Result<Stop<S::Guard, O::Halt>, SolveError>
 where
     S: OdeSystem<N>,
     O: Observer<S, N>,
@@ -62,6 +67,7 @@ where
     let mut g0 = [0.0; MAX_GUARDS];
     let mut g1 = [0.0; MAX_GUARDS];
     let ng = sys.guards(*t, y, &mut g0);
+    debug_assert!(ng <= S::Guard::ALL.len() && S::Guard::ALL.len() <= MAX_GUARDS);
     while *t < t_end {
         let h_cap = sys.max_step_at(*t, y).min(t_end - *t);
         let dense = stepper.step(sys, *t, y, h_cap)?;
@@ -108,7 +114,9 @@ where
                 let view = StepView { dense: cut };
                 // The observer sees the step up to the event; a break here is moot.
                 let _ = observer.on_step(sys, &view);
-                return Ok(Stop::Event { index });
+                return Ok(Stop::Event {
+                    guard: S::Guard::ALL[index],
+                });
             }
             None => {
                 *t = t1;
@@ -117,8 +125,8 @@ where
                 let view = StepView {
                     dense: stepper.last_dense(),
                 };
-                if observer.on_step(sys, &view).is_break() {
-                    return Ok(Stop::Observer);
+                if let ControlFlow::Break(halt) = observer.on_step(sys, &view) {
+                    return Ok(Stop::Halted(halt));
                 }
             }
         }

@@ -11,6 +11,7 @@ mod control;
 mod dop853;
 mod dopri5;
 mod events;
+mod hybrid;
 mod integrate;
 mod rosw;
 mod step;
@@ -21,8 +22,11 @@ pub use control::StepCore;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;
 pub use events::locate_crossing;
+pub use hybrid::{run_hybrid, Finish, Hybrid, HybridObserver, JumpRules};
 pub use integrate::{integrate, NoObserver, Observer, StepView, Stop};
 pub use rosw::Ros34pw2;
 pub use step::{Dense, Stats, StepControl};
 pub use stepper::Stepper;
-pub use system::{JacobianMatrix, OdeSystem, StiffJacobian, MAX_GUARDS, MAX_STIFF};
+pub use system::{
+    GuardSet, JacobianMatrix, NoGuard, OdeSystem, StiffJacobian, MAX_GUARDS, MAX_STIFF,
+};

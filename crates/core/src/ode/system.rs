@@ -1,8 +1,27 @@
 //! What a problem is to the integrator: a right-hand side, step bounds, guard functions and an
 //! optional stiff Jacobian. Nothing here knows the steppers.
 
+use std::fmt::Debug;
+
 /// Most guard functions one mode of a system may declare.
 pub const MAX_GUARDS: usize = 4;
+
+/// The named guard functions of a system: one value per guard, each with a fixed index, its
+/// slot in the array [`OdeSystem::guards`] fills. The driver reports a crossing as the guard
+/// that crossed, so a caller matches on names, not on slot numbers.
+pub trait GuardSet: Copy + Debug + PartialEq + 'static {
+    /// Every guard in index order: guard `ALL[i]` is written into `g[i]`. At most
+    /// [`MAX_GUARDS`] of them.
+    const ALL: &'static [Self];
+}
+
+/// The guard set of a system without discrete modes: it has no guard at all.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoGuard {}
+
+impl GuardSet for NoGuard {
+    const ALL: &'static [Self] = &[];
+}
 
 /// Most state components an approximate (stiff) Jacobian may couple.
 pub const MAX_STIFF: usize = 10;
@@ -45,12 +64,15 @@ impl StiffJacobian {
 
 /// A first-order system `y' = f(t, y)` with a fixed-size state and mode guards.
 pub trait OdeSystem<const N: usize> {
+    /// The system's guards by name ([`NoGuard`] for a system without modes).
+    type Guard: GuardSet;
+
     /// Writes `f(t, y)` into `dy`.
     fn rhs(&self, t: f64, y: &[f64; N], dy: &mut [f64; N]);
 
-    /// Writes the current mode's guard values into `g` and returns how many there are.
-    /// Each guard is positive while the mode holds; a crossing to `<= 0` is an event.
-    /// The default has none.
+    /// Writes the current mode's guard values into `g` and returns how many are active: the
+    /// first `n` of [`GuardSet::ALL`], guard `ALL[i]` in `g[i]`. Each guard is positive while
+    /// the mode holds; a crossing to `<= 0` is an event. The default has none.
     fn guards(&self, _t: f64, _y: &[f64; N], _g: &mut [f64; MAX_GUARDS]) -> usize {
         0
     }
