@@ -1,21 +1,12 @@
-//! The discrete side of the model: its modes, its named guards and its jump map (the paper's
+//! The discrete side of the model: its named guards and its jump map over the [`Mode`]s (the paper's
 //! eqs. 7-10 read as a hybrid system: a contact carries force while eq. 7's force is
 //! positive, and the friction switches between slip, eq. 8, and stick, eqs. 9-10).
 
+use super::forces::Forces;
 use super::friction::{self, Slip};
-use super::{ix, DropSystem, Forces, N};
+use super::state::{ix, Mode, N};
+use super::DropSystem;
 use crate::ode::{GuardSet, Hybrid, MAX_GUARDS};
-
-/// The discrete mode: which contacts carry force and how the rotor-race contact rubs.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Mode {
-    /// Rotor-race contact active (eq. 7 force on).
-    pub contact: bool,
-    /// Race-on-balls support active (its damper never pulls either).
-    pub support: bool,
-    /// Friction state of the rotor-race contact while `contact`.
-    pub slip: Slip,
-}
 
 /// The guards of the model, each positive while its part of the [`Mode`] holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,11 +42,12 @@ impl DropSystem {
         g[Guard::Contact.index()] = if self.mode.contact { c } else { -c };
         let sup = f.support_raw_n / self.f_ref_b;
         g[Guard::Support.index()] = if self.mode.support { sup } else { -sup };
-        if self.mode.contact && self.friction_switches() {
+        if self.mode.contact && self.friction.switches() {
             g[Guard::Friction.index()] = match self.mode.slip {
                 Slip::Slipping(sign) => sign * f.v_rel_m_s,
                 Slip::Sticking => {
-                    (self.mu_s * f.normal_n - f.friction_required_n.abs()) / self.f_ref
+                    (self.friction.static_limit_n(f.normal_n) - f.friction_required_n.abs())
+                        / self.f_ref
                 }
             };
             3
@@ -76,7 +68,7 @@ impl DropSystem {
     /// that keeps rolling is at most `mu_s F_n`, else slip along that friction's sign.
     /// `at_zero` forces the stick test (the state sits at a located v_rel = 0 crossing).
     pub fn entering_slip(&self, y: &[f64; N], at_zero: bool) -> Slip {
-        if !self.friction_switches() {
+        if !self.friction.switches() {
             return Slip::Slipping(1.0);
         }
         let mode = Mode {
@@ -89,7 +81,10 @@ impl DropSystem {
         if !at_zero && f.v_rel_m_s.abs() > v_scale {
             return Slip::Slipping(f.v_rel_m_s.signum());
         }
-        friction::stick_or_slip(f.friction_required_n, self.mu_s * f.normal_n.max(0.0))
+        friction::stick_or_slip(
+            f.friction_required_n,
+            self.friction.static_limit_n(f.normal_n.max(0.0)),
+        )
     }
 
     /// The jump map: the mode after `guard` crossed at state `y` (eqs. 7-10). A contact
