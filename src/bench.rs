@@ -1,4 +1,4 @@
-//! `whirlmap bench`: the performance figures the README reports, as counts and ratios.
+//! `whirlmap bench`: the performance figures docs/performance.md reports, as counts and ratios.
 
 use std::convert::Infallible;
 use std::hint::black_box;

@@ -40,8 +40,8 @@ pub struct DropOptions {
     /// Simulated time after release (s). Default 1. Allowed (0, 3600].
     pub duration_s: f64,
     /// Contact episodes separated by less than this count as one impact (s). Default 0.5 ms
-    /// (MODEL-NOTES: the light race can leave the rotor for a fraction of a millisecond
-    /// inside one impact).
+    /// (the light race can leave the rotor for a fraction of a millisecond inside one impact;
+    /// docs/model.md#impacts-and-the-first-contact-force).
     pub impact_merge_s: f64,
     /// Record the orbit with about this many samples (`None`: O(1) memory, no orbit).
     pub orbit_points: Option<usize>,
@@ -338,7 +338,7 @@ pub(crate) fn tolerances(scene: &Scene, sys: &DropSystem) -> StepControl<N> {
 
 /// The scene's optional release state (offset, velocity, race spin) on top of the default
 /// release (rotor at the centre at rest, race at rest at its static sag). All zero by default,
-/// so the state is then exactly the MODEL-NOTES release.
+/// so the state is then exactly the release of docs/model.md#release-state.
 fn apply_release(scene: &Scene, y: &mut [f64; N]) {
     y[ix::XR] += scene.release_offset_m[0];
     y[ix::YR] += scene.release_offset_m[1];

@@ -1,13 +1,14 @@
 //! The rotor-race-support model of the paper's Sec. 2 as an [`OdeSystem`].
 //!
-//! Frame and signs (MODEL-NOTES): x horizontal, y up, gravity `-g` on both bodies,
-//! counter-clockwise angles positive. Contact geometry is relative: `d = O_r - O_b`,
-//! `n = d/|d|`, `t = (-n_y, n_x)`, contact angle `alpha = atan2(d_y, d_x)`, penetration
-//! `delta = |d| - s`. Slip velocity `v_rel = (v_r - v_b).t + omega_r r_r - omega_b R_b`
-//! (eq. 9's rolling condition is `v_rel = 0`). The rotor gets `-F_n n - F_t t` and the torque
-//! `-F_t r_r` (eqs. 1-3); the race gets `+F_n n + F_t t` and `+F_t R_b` (Newton's third law;
-//! printed eqs. 4-6 give the race friction the rotor's sign, read as a typo), plus the ball
-//! support force and the Palmgren drag torque.
+//! Frame and signs (docs/model.md#frame-and-signs): x horizontal, y up, gravity `-g` on both
+//! bodies, counter-clockwise angles positive. Contact geometry is relative
+//! (docs/model.md#contact-geometry): `d = O_r - O_b`, `n = d/|d|`, `t = (-n_y, n_x)`, contact
+//! angle `alpha = atan2(d_y, d_x)`, penetration `delta = |d| - s`. Slip velocity
+//! `v_rel = (v_r - v_b).t + omega_r r_r - omega_b R_b` (eq. 9's rolling condition is
+//! `v_rel = 0`). The rotor gets `-F_n n - F_t t` and the torque `-F_t r_r` (eqs. 1-3); the race
+//! gets `+F_n n + F_t t` and `+F_t R_b` (Newton's third law; printed eqs. 4-6 give the race
+//! friction the rotor's sign, read as a typo: docs/model.md#newtons-third-law-at-the-contact),
+//! plus the ball support force and the Palmgren drag torque.
 
 pub mod drag;
 mod energy;
@@ -129,8 +130,9 @@ impl DropSystem {
         }
     }
 
-    /// The release state (MODEL-NOTES): rotor centre at the housing centre at rest with spin
-    /// Omega; race at rest at its static sag on the balls, `(m_b g / k2)^(1/e2)` below centre.
+    /// The release state (docs/model.md#release-state): rotor centre at the housing centre at
+    /// rest with spin Omega; race at rest at its static sag on the balls, `(m_b g / k2)^(1/e2)`
+    /// below centre.
     /// Also sets the initial mode (rotor free, race on its support).
     pub fn initial_state(&mut self, spin_rad_s: f64) -> [f64; N] {
         let mut y = [0.0; N];
