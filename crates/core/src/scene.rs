@@ -29,14 +29,15 @@ pub enum FrictionLaw {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
-    /// Dormand-Prince 5(4) with 4th-order dense output: the `reference` fidelity's pair.
+    /// Dormand-Prince 5(4) with 4th-order dense output: the pair of the `standard` (the
+    /// scene default) and `reference` fidelities.
     Dopri5,
     /// Hairer's DOP853, 8(5,3) with 7th-order dense output: the independent reference of
     /// `whirlmap accuracy` (see `ode/dop853.rs` for why it is hand-written).
     Dop853,
     /// ROS34PW2, a linearly implicit Rosenbrock-W method of order 3 (Rang and Angermann
     /// 2005) with an analytic stiff Jacobian: its step is not bounded by the light race's
-    /// contact mode (`ode/rosw.rs`). The default.
+    /// contact mode (`ode/rosw.rs`). The `draft` fidelity's.
     #[default]
     Ros34pw2,
 }
@@ -66,9 +67,9 @@ pub enum SupportDamper {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverSettings {
-    /// Relative tolerance. Default 1e-4 (the `standard` fidelity: forces and peak heat power
-    /// within 0.1 % of the reference, whirl frequency within 1 %; docs/performance.md).
-    /// Allowed (0, 1e-2].
+    /// Relative tolerance. Default 3e-5 (the `standard` fidelity: forces and peak heat power
+    /// within 0.1 % of the reference, whirl frequency within 1 %;
+    /// docs/accuracy.md#fidelity-presets). Allowed (0, 1e-2].
     pub rtol: f64,
     /// Position scale for the absolute tolerance (m): `atol = rtol * position_scale_m` on
     /// displacements. Default 1e-6 m, so a 1 um penetration is resolved to `rtol`.
@@ -82,14 +83,14 @@ pub struct SolverSettings {
     pub max_step_attempts: u64,
     /// Located mode switches before a typed budget error (chatter guard). Default 2 000 000.
     pub max_events: u64,
-    /// The integrator. Default `ros34pw2`, the linearly implicit Rosenbrock-W method (its
-    /// step is not bounded by the light race's contact modes); `dopri5` is the explicit
-    /// Dormand-Prince 5(4) pair (the `reference` fidelity's); `dop853` the independent
-    /// reference of `whirlmap accuracy`.
+    /// The integrator. Default `dopri5`, the explicit Dormand-Prince 5(4) pair (the
+    /// `standard` and `reference` fidelities'); `ros34pw2` is the linearly implicit
+    /// Rosenbrock-W method, whose step is not bounded by the light race's contact modes (the
+    /// `draft` fidelity's); `dop853` the independent reference of `whirlmap accuracy`.
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a
-    /// bound on the relative acceleration). Default true.
+    /// bound on the relative acceleration). Default false (true in the `draft` fidelity).
     pub free_flight_gap_bound: bool,
     /// Factor on the absolute tolerances of the race's translation (its centre's position
     /// and velocity). The race centre is a fast variable held by two stiff springs (its own
@@ -97,8 +98,9 @@ pub struct SolverSettings {
     /// (`support_damper = isotropic`, the default) and an L-stable stepper (`ros34pw2`) its
     /// local errors decay instead of accumulating, and the rotor's absolute tolerances
     /// (`rtol * position_scale_m` on positions, `rtol * sqrt(2 g s) / 100` on velocities)
-    /// would bound the implicit step in contact. Default 1000 (the `standard` fidelity; the
-    /// accuracy it costs is measured by `whirlmap accuracy`). Allowed [1, 1e4].
+    /// would bound the implicit step in contact. Default 1; 1000 in the `draft` fidelity,
+    /// whose accuracy cost is measured by `whirlmap accuracy`
+    /// (docs/accuracy.md#the-races-absolute-tolerance). Allowed [1, 1e4].
     pub race_atol_scale: f64,
 }
 
