@@ -1,4 +1,4 @@
-//! The full stability matrix (README, "Stability at the extremes"):
+//! The full stability matrix (docs/accuracy.md#stability-at-the-extremes):
 //! `cargo run --release --example extremes [-- --json]`. Prints one line per point and exits
 //! 1 if any point breaks the contract (a non-finite result, a failed energy audit, a panic, or
 //! a valid scene rejected).

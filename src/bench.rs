@@ -1,5 +1,6 @@
-//! `whirlmap bench`: the performance figures the README reports, as counts and ratios.
+//! `whirlmap bench`: the performance figures docs/performance.md reports, as counts and ratios.
 
+use std::convert::Infallible;
 use std::hint::black_box;
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -11,7 +12,8 @@ use whirlmap_core::{simulate_observed, DropOptions, DropReport, Fidelity, Scene,
 #[derive(Default)]
 struct EvalCount(ModelEvals);
 impl Observer<DropSystem, N> for EvalCount {
-    fn on_step(&mut self, sys: &DropSystem, _s: &StepView<'_, N>) -> ControlFlow<()> {
+    type Halt = Infallible;
+    fn on_step(&mut self, sys: &DropSystem, _s: &StepView<'_, N>) -> ControlFlow<Infallible> {
         self.0 = sys.model_evals();
         ControlFlow::Continue(())
     }

@@ -2,6 +2,7 @@
 //! sticking, slipping), to see where a stepper spends its steps.
 //! `cargo run --release -p whirlmap-core --example steps -- [rtol=1e-4] [ros=true]
 //! [gap=true] [iso=true] [race=1000] [mu=0.1] [rpm=8000]`.
+use std::convert::Infallible;
 use std::ops::ControlFlow;
 use whirlmap_core::ode::{Observer, StepView};
 use whirlmap_core::*;
@@ -11,11 +12,12 @@ struct Rec(
     Vec<(f64, f64, f64)>,
 );
 impl Observer<model::DropSystem, { model::N }> for Rec {
+    type Halt = Infallible;
     fn on_step(
         &mut self,
         sys: &model::DropSystem,
         s: &StepView<'_, { model::N }>,
-    ) -> ControlFlow<()> {
+    ) -> ControlFlow<Infallible> {
         let m = sys.mode;
         let sl = match m.slip {
             model::Slip::Sticking => 0,

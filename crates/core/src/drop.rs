@@ -3,11 +3,11 @@
 
 use crate::classify::{classify, Verdict};
 use crate::error::{InvalidParameter, SolveError};
-use crate::model::{ix, DropSystem, Mode, Slip, N};
-use crate::monitor::{Features, Monitor};
+use crate::model::{ix, DropSystem, Mode, N};
+use crate::monitor::{Features, Monitor, WhirlDecided};
 use crate::ode::{
-    integrate, Dop853, Dopri5, NoObserver, Observer, Ros34pw2, Stats, StepControl, StepView,
-    Stepper, Stop,
+    run_hybrid, Dop853, Dopri5, Finish, HybridObserver, JumpRules, NoObserver, Observer, Ros34pw2,
+    Stats, StepControl, StepView, Stepper,
 };
 use crate::orbit::Orbit;
 use crate::scene::{Method, Scene};
@@ -30,7 +30,7 @@ use std::ops::ControlFlow;
 /// - 2: a slip entered against the drifted slip velocity takes its sign.
 pub const MODEL_VERSION: u32 = 5;
 
-/// Largest first step after a mode switch (s): see [`Dopri5::cap_next_step`].
+/// Largest first step after a mode switch (s): see [`Stepper::cap_next_step`].
 pub(crate) const STEP_AFTER_SWITCH_S: f64 = 1e-7;
 
 /// How to run a drop (what is not physics).
@@ -40,8 +40,8 @@ pub struct DropOptions {
     /// Simulated time after release (s). Default 1. Allowed (0, 3600].
     pub duration_s: f64,
     /// Contact episodes separated by less than this count as one impact (s). Default 0.5 ms
-    /// (MODEL-NOTES: the light race can leave the rotor for a fraction of a millisecond
-    /// inside one impact).
+    /// (the light race can leave the rotor for a fraction of a millisecond inside one impact;
+    /// docs/model.md#impacts-and-the-first-contact-force).
     pub impact_merge_s: f64,
     /// Record the orbit with about this many samples (`None`: O(1) memory, no orbit).
     pub orbit_points: Option<usize>,
@@ -222,45 +222,78 @@ pub struct DropReport {
     pub extension_s: f64,
 }
 
+/// Why the drop's observer halted the integration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Halt {
+    /// The monitor's whirl stopping rule decided.
+    WhirlDecided,
+    /// The rotor spin fell below the stop speed.
+    StopSpeed,
+    /// The thermal network advanced over a macro-step end: the thermal load must be updated
+    /// before the run goes on.
+    ThermalSync,
+}
+
 /// Passes every step to an extra observer, then to the monitor, which may stop the run, as
 /// may the coast-down's stop speed; then advances the thermal network over every macro-step
-/// end the step passed.
+/// end the step passed. At each jump it books the switch's energy and tells the monitor.
 struct Tap<'a, O> {
     extra: &'a mut O,
-    mon: &'a mut Monitor,
+    mon: Monitor,
     /// Stop once |omega_r| falls below this (rad/s); 0 for never.
     stop_speed_rad_s: f64,
-    /// Set when the stop speed stopped the run.
-    speed_stopped: bool,
     /// The macro-step coupling, when the scene has a thermal model.
-    thermal: Option<&'a mut ThermalRun>,
-    /// Set when the network advanced, so the driver can update F_th in the system.
-    synced: bool,
+    thermal: Option<ThermalRun>,
+    /// Mechanical energy lost at mode switches (J): the elastic energy of a contact opened
+    /// while still overlapping, booked with the damping loss.
+    switch_loss_j: f64,
 }
 
 impl<O: Observer<DropSystem, N>> Observer<DropSystem, N> for Tap<'_, O> {
-    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
+    type Halt = Halt;
+    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<Halt> {
         let _ = self.extra.on_step(sys, step);
-        self.mon.on_step(sys, step)?;
-        if self.stop_speed_rad_s > 0.0 && step.dense.y1()[ix::WR].abs() < self.stop_speed_rad_s {
-            self.speed_stopped = true;
-            return ControlFlow::Break(());
+        if let ControlFlow::Break(WhirlDecided) = self.mon.on_step(sys, step) {
+            return ControlFlow::Break(Halt::WhirlDecided);
         }
-        if let Some(th) = self.thermal.as_deref_mut() {
+        if self.stop_speed_rad_s > 0.0 && step.dense.y1()[ix::WR].abs() < self.stop_speed_rad_s {
+            return ControlFlow::Break(Halt::StopSpeed);
+        }
+        if let Some(th) = self.thermal.as_mut() {
             // Macro-step ends are met on the step's interpolant, so the dynamic steps are not
             // cut at them (a cut leaves a tiny last step that resets the step-size
             // controller); the new F_th takes effect from this step's end.
             let t1 = step.dense.t1();
+            let mut synced = false;
             while th.next_boundary() <= t1 {
                 let tb = th.next_boundary();
                 th.advance(tb, &step.dense.eval(tb));
-                self.synced = true;
+                synced = true;
             }
-            if self.synced {
-                return ControlFlow::Break(());
+            if synced {
+                return ControlFlow::Break(Halt::ThermalSync);
             }
         }
         ControlFlow::Continue(())
+    }
+}
+
+impl<O: Observer<DropSystem, N>> HybridObserver<DropSystem, N> for Tap<'_, O> {
+    fn on_jump(&mut self, sys: &DropSystem, t: f64, y: &[f64; N], from: Mode, to: Mode) {
+        self.switch_loss_j += sys.mechanical_energy(y, from) - sys.mechanical_energy(y, to);
+        if from.contact != to.contact {
+            self.mon.contact_switch(t, to.contact);
+        }
+        self.mon.mode_switched();
+    }
+}
+
+/// How the drop's event loop treats jumps: the scene's event budget, and a first step after
+/// a switch of at most [`STEP_AFTER_SWITCH_S`].
+pub(crate) fn jump_rules(scene: &Scene) -> JumpRules {
+    JumpRules {
+        max_events: scene.solver.max_events,
+        step_after_jump_s: STEP_AFTER_SWITCH_S,
     }
 }
 
@@ -303,62 +336,9 @@ pub(crate) fn tolerances(scene: &Scene, sys: &DropSystem) -> StepControl<N> {
     }
 }
 
-/// The mode after guard `index` fired at state `y` (see [`DropSystem`]'s guards).
-pub(crate) fn next_mode(sys: &DropSystem, y: &[f64; N], index: usize) -> Mode {
-    let mut m = sys.mode;
-    match index {
-        0 => {
-            m.contact = !m.contact;
-            if m.contact {
-                m.slip = sys.entering_slip(y, false);
-            }
-        }
-        1 => m.support = !m.support,
-        _ => {
-            m.slip = match m.slip {
-                Slip::Slipping(_) => sys.entering_slip(y, true),
-                Slip::Sticking => {
-                    let req = sys.forces(y).friction_required_n;
-                    Slip::Slipping(if req >= 0.0 { 1.0 } else { -1.0 })
-                }
-            };
-        }
-    }
-    // Every slip entered here (at a contact onset or a friction switch, including a slip
-    // that keeps its sign through a located reversal) starts consistent.
-    if index != 1 && m.contact {
-        if let Slip::Slipping(sign) = m.slip {
-            m.slip = Slip::Slipping(slip_along_drift(sys, y, m, sign));
-        }
-    }
-    m
-}
-
-/// The sign of a slip entered at a contact onset or a friction switch (eqs. 9-10), made
-/// consistent with the slip velocity actually there.
-///
-/// Slip starts along the friction demand (or along `v_rel` at an onset). But a sticking
-/// contact holds `v_rel` only through its acceleration, so `v_rel` drifts by the
-/// integration error while it sticks, and a reversal is located only to within the root
-/// tolerance. If that small `v_rel` points against the demand, the new mode's guard
-/// (`sign * v_rel`) starts negative; the event loop watches guards crossing from positive to
-/// zero, so it would never see it, and the friction, pushing along the slip instead of
-/// against it, would make energy (measured before this rule: -1085 J of "friction heat" in
-/// a 1 s drop at a loose tolerance). So the slip takes the sign of `v_rel` there: friction
-/// then opposes it, `v_rel` returns through zero at once, and that reversal event re-enters
-/// the slip along the demand.
-fn slip_along_drift(sys: &DropSystem, y: &[f64; N], mode: Mode, sign: f64) -> f64 {
-    let v_rel = sys.forces_in(y, mode).v_rel_m_s;
-    if sign * v_rel < 0.0 {
-        -sign
-    } else {
-        sign
-    }
-}
-
 /// The scene's optional release state (offset, velocity, race spin) on top of the default
 /// release (rotor at the centre at rest, race at rest at its static sag). All zero by default,
-/// so the state is then exactly the MODEL-NOTES release.
+/// so the state is then exactly the release of docs/model.md#release-state.
 fn apply_release(scene: &Scene, y: &mut [f64; N]) {
     y[ix::XR] += scene.release_offset_m[0];
     y[ix::YR] += scene.release_offset_m[1];
@@ -418,59 +398,54 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
     let mut t_end = opts.duration_s;
     mon.start(&sys, &y);
     // The thermal model, if asked for: the dynamics then run in macro steps (crate::thermal).
-    let mut thermal = match &scene.thermal {
+    let thermal = match &scene.thermal {
         Some(p) => Some(ThermalRun::new(scene, p, opts.duration_s, &y)?),
         None => None,
     };
-    let stop_speed_rad_s = scene.stop_speed_rpm.unwrap_or(0.0) * std::f64::consts::PI / 30.0;
+    let mut tap = Tap {
+        extra,
+        mon,
+        stop_speed_rad_s: scene.stop_speed_rpm.unwrap_or(0.0) * std::f64::consts::PI / 30.0,
+        thermal,
+        switch_loss_j: 0.0,
+    };
+    let rules = jump_rules(scene);
     let mut t = 0.0;
-    let mut switch_loss = 0.0;
     let stop_reason = loop {
-        let mut tap = Tap {
-            extra: &mut *extra,
-            mon: &mut mon,
-            stop_speed_rad_s,
-            speed_stopped: false,
-            thermal: thermal.as_mut(),
-            synced: false,
-        };
-        match integrate(&sys, &mut stepper, &mut t, &mut y, t_end, &mut tap)? {
-            Stop::EndTime => {
+        match run_hybrid(
+            &mut sys,
+            &mut stepper,
+            &mut t,
+            &mut y,
+            t_end,
+            &mut tap,
+            &rules,
+        )? {
+            Finish::EndTime => {
                 let settled =
-                    classify(&mon.features(t, &y), StopReason::DurationReached, cls).settled;
+                    classify(&tap.mon.features(t, &y), StopReason::DurationReached, cls).settled;
                 if settled || t_end >= end_cap_s {
                     break StopReason::DurationReached;
                 }
                 // A run shorter than the window goes straight to its length.
                 t_end = (t_end + extension_step_s).max(cls.window_s).min(end_cap_s);
             }
-            Stop::Observer if tap.speed_stopped => break StopReason::StopSpeedReached,
-            Stop::Observer if tap.synced => {
+            Finish::Halted(Halt::StopSpeed) => break StopReason::StopSpeedReached,
+            Finish::Halted(Halt::ThermalSync) => {
                 // The network advanced: F_th (eq. 30) for the next macro step (eq. 31).
-                if let Some(th) = thermal.as_ref() {
+                if let Some(th) = tap.thermal.as_ref() {
                     sys.thermal_load_n = th.load_n();
                 }
             }
-            Stop::Observer => break StopReason::WhirlDecided,
-            Stop::Event { index } => {
-                if stepper.stats().events >= scene.solver.max_events {
-                    return Err(SolveError::EventBudget {
-                        t_s: t,
-                        events: stepper.stats().events,
-                    });
-                }
-                let old = sys.mode;
-                let new = next_mode(&sys, &y, index);
-                switch_loss += sys.mechanical_energy(&y, old) - sys.mechanical_energy(&y, new);
-                if old.contact != new.contact {
-                    mon.contact_switch(t, new.contact);
-                }
-                sys.mode = new;
-                mon.mode_switched();
-                stepper.cap_next_step(STEP_AFTER_SWITCH_S);
-            }
+            Finish::Halted(Halt::WhirlDecided) => break StopReason::WhirlDecided,
         }
     };
+    let Tap {
+        mon,
+        thermal,
+        switch_loss_j: switch_loss,
+        ..
+    } = tap;
     if y.iter().any(|v| !v.is_finite()) {
         return Err(SolveError::NonFiniteState { t_s: t });
     }

@@ -1,5 +1,6 @@
 //! Fidelity presets: named trade-offs between speed and accuracy, chosen from the measured
-//! work-precision study of `whirlmap accuracy` (`results/accuracy/`, docs/performance.md).
+//! work-precision study of `whirlmap accuracy` (`results/accuracy/`,
+//! docs/accuracy.md#fidelity-presets).
 //!
 //! A preset sets only numerics: the tolerance, the integrator, the free-flight gap bound and
 //! the race's tolerance scale (and the full model: it switches the quasi-static race off). It
@@ -14,14 +15,15 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
-    /// Screening: the `standard` numerics at rtol 3e-4. In the work-precision study's five
-    /// cases: forces and peak heat within 0.2 %, whirl frequency within 2 %, every class
-    /// right, about 20 % cheaper than `standard`.
+    /// Screening: ROS34PW2 (linearly implicit, L-stable) with the free-flight gap bound and
+    /// the race's absolute tolerances x1000, at rtol 1e-4. About ten times cheaper than
+    /// `standard`, but outside the accuracy budget: on bouncing sequences its maximum force
+    /// is off by up to 12 % (docs/accuracy.md#fidelity-presets).
     Draft,
-    /// Design work, and the scene default: ROS34PW2 (linearly implicit, L-stable) with the
-    /// free-flight gap bound and the race's absolute tolerances x1000, at rtol 1e-4; the
-    /// cheapest setting of the study within the budget (first and maximum contact force and
-    /// peak heat power within 0.1 % of `reference`, whirl frequency within 1 %, the same class).
+    /// Design work, and the scene default: DOPRI5 at rtol 3e-5, the cheapest setting measured
+    /// within the budget (first and maximum contact force and peak heat power within 0.1 % of
+    /// `reference`, whirl frequency within 1 %, the same class away from a transition;
+    /// docs/accuracy.md#fidelity-presets).
     Standard,
     /// DOPRI5 at rtol 1e-9: the reference of the accuracy and convergence studies (DOP853 at
     /// rtol 1e-10 confirms it to 6e-6).

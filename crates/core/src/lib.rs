@@ -3,7 +3,7 @@
 //! A rotor falls out of its active magnetic bearings onto a touchdown ball bearing. This
 //! crate simulates that drop as in the paper *A performance analysis model with thermodynamic
 //! and superficial effects of the touchdown bearings in AMB systems* (eqs. 1-13 and 17), with
-//! the points the paper leaves open resolved as the README's model section says. No threads,
+//! the points the paper leaves open resolved as docs/model.md says. No threads,
 //! no files, no plotting: a sweep crate fans it out and draws the charts.
 //!
 //! ## State

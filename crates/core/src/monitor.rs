@@ -705,8 +705,14 @@ impl Monitor {
     }
 }
 
+/// The monitor's halt: the whirl stopping rule decided (the contact point made the scene's
+/// `whirl_stop_turns` consecutive carried turns in one direction).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WhirlDecided;
+
 impl Observer<DropSystem, N> for Monitor {
-    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
+    type Halt = WhirlDecided;
+    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<WhirlDecided> {
         let d = step.dense;
         let (t0, t1) = (d.t0(), d.t1());
         let tm = 0.5 * (t0 + t1);
@@ -741,7 +747,7 @@ impl Observer<DropSystem, N> for Monitor {
         self.last_t = t1;
         self.record_orbit(sys, t1, &y1, false);
         if self.whirl_decided {
-            ControlFlow::Break(())
+            ControlFlow::Break(WhirlDecided)
         } else {
             ControlFlow::Continue(())
         }

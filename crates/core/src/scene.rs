@@ -1,9 +1,9 @@
 //! Every parameter of a drop: plain data in SI units, documented field by field with unit,
 //! default, allowed range and source, validated once at the boundary.
 //!
-//! The default scene is the paper's: Tables 2-4 of the seed paper plus the MODEL-NOTES
-//! defaults (`Scene::paper()`); catalogue units (N/mm^1.5, cSt, N mm) are converted here and
-//! in [`crate::model::drag`], nowhere else.
+//! The default scene is the paper's: its Tables 2-4 plus the defaults of
+//! docs/model.md#default-scene (`Scene::paper()`); catalogue units (N/mm^1.5, cSt, N mm) are
+//! converted here and in [`crate::model::drag`], nowhere else.
 
 use crate::classify::ClassifyParams;
 use crate::error::InvalidParameter;
@@ -18,7 +18,7 @@ pub enum FrictionLaw {
     /// as events. While sticking the rolling constraint holds exactly.
     Switched,
     /// `F_t = mu_d F_n tanh(v_rel / v_eps_m_s)`: a cheaper approximation with no stick mode.
-    /// Its error against `switched` is measured, not assumed (see the README).
+    /// Its error against `switched` is measured, not assumed (docs/accuracy.md).
     Regularised {
         /// Slip velocity scale of the tanh (m/s), > 0.
         v_eps_m_s: f64,
@@ -29,14 +29,15 @@ pub enum FrictionLaw {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
-    /// Dormand-Prince 5(4) with 4th-order dense output: the `reference` fidelity's pair.
+    /// Dormand-Prince 5(4) with 4th-order dense output: the pair of the `standard` (the
+    /// scene default) and `reference` fidelities.
     Dopri5,
     /// Hairer's DOP853, 8(5,3) with 7th-order dense output: the independent reference of
     /// `whirlmap accuracy` (see `ode/dop853.rs` for why it is hand-written).
     Dop853,
     /// ROS34PW2, a linearly implicit Rosenbrock-W method of order 3 (Rang and Angermann
     /// 2005) with an analytic stiff Jacobian: its step is not bounded by the light race's
-    /// contact mode (`ode/rosw.rs`). The default.
+    /// contact mode (`ode/rosw.rs`). The `draft` fidelity's.
     #[default]
     Ros34pw2,
 }
@@ -66,9 +67,9 @@ pub enum SupportDamper {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverSettings {
-    /// Relative tolerance. Default 1e-4 (the `standard` fidelity: forces and peak heat power
-    /// within 0.1 % of the reference, whirl frequency within 1 %; docs/performance.md).
-    /// Allowed (0, 1e-2].
+    /// Relative tolerance. Default 3e-5 (the `standard` fidelity: forces and peak heat power
+    /// within 0.1 % of the reference, whirl frequency within 1 %;
+    /// docs/accuracy.md#fidelity-presets). Allowed (0, 1e-2].
     pub rtol: f64,
     /// Position scale for the absolute tolerance (m): `atol = rtol * position_scale_m` on
     /// displacements. Default 1e-6 m, so a 1 um penetration is resolved to `rtol`.
@@ -82,14 +83,14 @@ pub struct SolverSettings {
     pub max_step_attempts: u64,
     /// Located mode switches before a typed budget error (chatter guard). Default 2 000 000.
     pub max_events: u64,
-    /// The integrator. Default `ros34pw2`, the linearly implicit Rosenbrock-W method (its
-    /// step is not bounded by the light race's contact modes); `dopri5` is the explicit
-    /// Dormand-Prince 5(4) pair (the `reference` fidelity's); `dop853` the independent
-    /// reference of `whirlmap accuracy`.
+    /// The integrator. Default `dopri5`, the explicit Dormand-Prince 5(4) pair (the
+    /// `standard` and `reference` fidelities'); `ros34pw2` is the linearly implicit
+    /// Rosenbrock-W method, whose step is not bounded by the light race's contact modes (the
+    /// `draft` fidelity's); `dop853` the independent reference of `whirlmap accuracy`.
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a
-    /// bound on the relative acceleration). Default true.
+    /// bound on the relative acceleration). Default false (true in the `draft` fidelity).
     pub free_flight_gap_bound: bool,
     /// Factor on the absolute tolerances of the race's translation (its centre's position
     /// and velocity). The race centre is a fast variable held by two stiff springs (its own
@@ -97,8 +98,9 @@ pub struct SolverSettings {
     /// (`support_damper = isotropic`, the default) and an L-stable stepper (`ros34pw2`) its
     /// local errors decay instead of accumulating, and the rotor's absolute tolerances
     /// (`rtol * position_scale_m` on positions, `rtol * sqrt(2 g s) / 100` on velocities)
-    /// would bound the implicit step in contact. Default 1000 (the `standard` fidelity; the
-    /// accuracy it costs is measured by `whirlmap accuracy`). Allowed [1, 1e4].
+    /// would bound the implicit step in contact. Default 1; 1000 in the `draft` fidelity,
+    /// whose accuracy cost is measured by `whirlmap accuracy`
+    /// (docs/accuracy.md#the-races-absolute-tolerance). Allowed [1, 1e4].
     pub race_atol_scale: f64,
 }
 
@@ -149,9 +151,9 @@ pub struct Scene {
     /// Allowed: a radius of gyration sqrt(J / m) within [0.01, 100] journal radii
     /// ([`Scene::validate_consistency`]).
     pub rotor_polar_moi_kg_m2: f64,
-    /// Share of the rotor carried by this touchdown location (MODEL-NOTES: two locations,
-    /// one at each end, so 0.5). Mass and inertia in the equations are scaled by it.
-    /// Allowed (0, 1].
+    /// Share of the rotor carried by this touchdown location (two locations, one at each
+    /// end, so 0.5; docs/model.md#load-share). Mass and inertia in the equations are scaled
+    /// by it. Allowed (0, 1].
     pub load_share: f64,
     /// Rotor journal diameter at the touchdown bearing (m). Table 2: 39.7 mm. Lever arm of
     /// the rotor's friction torque is half of it (eq. 3's r).
@@ -162,12 +164,12 @@ pub struct Scene {
     /// Angle of the unbalance at release, from +x, counter-clockwise (rad). Default 0.
     pub unbalance_phase_rad: f64,
 
-    // ---- release state (issue 7: what a real drop does not control) ----------------------
+    // ---- release state (what a real drop does not control; docs/model.md#release-state) ---
     // Optional: left out of the JSON (and so of the scene hash) while at their defaults, so
     // scenes without them keep their hash and records. See [`Scene::OPTIONAL_FIELDS`].
     /// Rotor geometric centre at release, relative to the housing (race) centre (m).
-    /// Default [0, 0] (MODEL-NOTES: released at the centre). Allowed: magnitude at most
-    /// 0.9 * clearance_m, so the release is clear of the race.
+    /// Default [0, 0] (released at the centre, docs/model.md#release-state). Allowed:
+    /// magnitude at most 0.9 * clearance_m, so the release is clear of the race.
     #[serde(skip_serializing_if = "is_zero2")]
     pub release_offset_m: [f64; 2],
     /// Rotor geometric centre velocity at release (m/s), e.g. the AMB orbit's. Default
@@ -186,7 +188,8 @@ pub struct Scene {
     /// gyration within [0.01, 100] race bore radii.
     pub race_polar_moi_kg_m2: f64,
     /// Radial clearance between rotor and race bore, s (m). Table 4: 0.15 mm. The race bore
-    /// radius is `rotor_diameter_m / 2 + clearance_m` (MODEL-NOTES). Allowed (0, 0.1].
+    /// radius is `rotor_diameter_m / 2 + clearance_m` (docs/model.md#lever-arms). Allowed
+    /// (0, 0.1].
     pub clearance_m: f64,
 
     // ---- contacts (Table 4, eq. 7) ------------------------------------------------------
@@ -199,9 +202,10 @@ pub struct Scene {
     /// Rotor-race contact damping c1 (N s/m). Table 4: 1000. Allowed [0, 1e8].
     pub contact_damping_n_s_per_m: f64,
     /// Race-on-balls lumped radial stiffness k2 (N/m^e). Table 4: 2.47e5 N/mm^1.5 =
-    /// 7.811e9 N/m^1.5 (converted here). Zero internal clearance, isotropic (MODEL-NOTES).
-    /// Allowed: a force at 1 um penetration, k2 (1e-6 m)^e, in [1e-3, 1e10] N (Table 4's:
-    /// 7.8 N; 2.47e5 read as N/m^1.5 gives 2.5e-4 N and is refused).
+    /// 7.811e9 N/m^1.5 (converted here). Zero internal clearance, isotropic
+    /// (docs/model.md#ball-support). Allowed: a force at 1 um penetration, k2 (1e-6 m)^e, in
+    /// [1e-3, 1e10] N (Table 4's: 7.8 N; 2.47e5 read as N/m^1.5 gives 2.5e-4 N and is
+    /// refused).
     pub support_stiffness_n_per_m_e: f64,
     /// Race-on-balls Hertz exponent. Point contact: 3/2. Allowed [1, 2].
     pub support_exponent: f64,
@@ -225,7 +229,8 @@ pub struct Scene {
     /// larger than the race bore diameter `rotor_diameter_m + 2 clearance_m`, at most 10 m.
     pub pitch_diameter_m: f64,
     /// Basic static load rating C0 of the bearing (N) in f1 = 0.001 (P0/C0)^0.33. Default
-    /// 10 000 N, the order of a 71908 catalogue entry (MODEL-NOTES). Allowed [1, 1e8].
+    /// 10 000 N, the order of a 71908 catalogue entry
+    /// (docs/model.md#static-load-rating-c0). Allowed [1, 1e8].
     pub static_load_rating_n: f64,
     /// Race speed below which the drag torque is scaled by tanh(omega / this) so it has a
     /// defined, chatter-free value at zero speed (rad/s). Default 0.1 (about 1 r/min).
@@ -244,7 +249,7 @@ pub struct Scene {
     /// Integrator settings.
     pub solver: SolverSettings,
 
-    // ---- reduced models (issue 5; each default off, and then left out of the JSON) -------
+    // ---- reduced models (each default off, and then left out of the JSON) ----------------
     /// Reduced model: the race's *translation* is massless (quasi-static). The race centre
     /// then follows from the force balance between the rotor contact and the ball support
     /// (two Hertz springs in series, see `model/quasi_static.rs`); its rotation keeps its
@@ -341,7 +346,8 @@ impl Scene {
         "thermal",
     ];
 
-    /// The paper's scene: Tables 2-4 with the MODEL-NOTES defaults, 8000 r/min, mu 0.1.
+    /// The paper's scene: Tables 2-4 with the defaults of docs/model.md#default-scene,
+    /// 8000 r/min, mu 0.1.
     pub fn paper() -> Self {
         Self {
             speed_rpm: 8000.0,

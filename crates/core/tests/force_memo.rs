@@ -2,6 +2,7 @@
 //! evaluation gives (every field, bit for bit), a changed mode or thermal load is never served
 //! from it, and in a real drop it does serve the repeated step-end and midpoint evaluations.
 
+use std::convert::Infallible;
 use std::ops::ControlFlow;
 use whirlmap_core::model::{ix, DropSystem, Forces, Mode, ModelEvals, Slip, N};
 use whirlmap_core::ode::{Observer, StepView};
@@ -41,7 +42,8 @@ struct Check {
     own_misses: u64,
 }
 impl Observer<DropSystem, N> for Check {
-    fn on_step(&mut self, sys: &DropSystem, s: &StepView<'_, N>) -> ControlFlow<()> {
+    type Halt = Infallible;
+    fn on_step(&mut self, sys: &DropSystem, s: &StepView<'_, N>) -> ControlFlow<Infallible> {
         let d = s.dense;
         let tm = 0.5 * (d.t0() + d.t1());
         let before = sys.model_evals();

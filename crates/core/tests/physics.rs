@@ -7,11 +7,12 @@
 // Gauss-Legendre nodes to full digits; `!(x < bound)` so a NaN fails.
 #![allow(clippy::excessive_precision, clippy::neg_cmp_op_on_partial_ord)]
 
+use std::convert::Infallible;
 use std::ops::ControlFlow;
 use whirlmap_core::model::friction::stick_or_slip;
 use whirlmap_core::model::{ix, DropSystem, Slip, N};
 use whirlmap_core::ode::{
-    integrate, Dopri5, Observer, OdeSystem, StepControl, StepView, Stop, MAX_GUARDS,
+    integrate, Dopri5, GuardSet, Observer, OdeSystem, StepControl, StepView, Stop, MAX_GUARDS,
 };
 use whirlmap_core::{
     simulate, simulate_observed, DropOptions, DropReport, Method, Scene, SolveError, StopReason,
@@ -330,7 +331,15 @@ impl Block {
     }
 }
 
+/// The block's one guard: the friction switch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SlipSwitch;
+impl GuardSet for SlipSwitch {
+    const ALL: &'static [Self] = &[SlipSwitch];
+}
+
 impl OdeSystem<3> for Block {
+    type Guard = SlipSwitch;
     fn rhs(&self, t: f64, y: &[f64; 3], dy: &mut [f64; 3]) {
         let f = self.friction(t);
         dy[0] = y[1];
@@ -350,7 +359,8 @@ impl OdeSystem<3> for Block {
 #[derive(Default)]
 struct Trace(Vec<(f64, [f64; 3])>);
 impl Observer<Block, 3> for Trace {
-    fn on_step(&mut self, _: &Block, step: &StepView<'_, 3>) -> ControlFlow<()> {
+    type Halt = Infallible;
+    fn on_step(&mut self, _: &Block, step: &StepView<'_, 3>) -> ControlFlow<Infallible> {
         self.0.push((step.dense.t1(), step.dense.y1()));
         ControlFlow::Continue(())
     }
@@ -376,7 +386,7 @@ fn run_block(b: &mut Block, y: &mut [f64; 3], t_end: f64, trace: &mut Trace) -> 
                 b.switch(t);
                 assert!(events.len() < 100, "chatter: {events:?}");
             }
-            Stop::Observer => unreachable!(),
+            Stop::Halted(never) => match never {},
         }
     }
     events
@@ -548,7 +558,8 @@ struct TorqueIntegral {
 }
 
 impl Observer<DropSystem, N> for TorqueIntegral {
-    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
+    type Halt = Infallible;
+    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<Infallible> {
         let d = step.dense;
         let (t0, t1) = (d.t0(), d.t1());
         let (mid, half) = (0.5 * (t0 + t1), 0.5 * (t1 - t0));
@@ -666,7 +677,8 @@ struct SignWatch {
 }
 
 impl Observer<DropSystem, N> for SignWatch {
-    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
+    type Halt = Infallible;
+    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<Infallible> {
         let d = step.dense;
         for t in [0.5 * (d.t0() + d.t1()), d.t1()] {
             let y = d.eval(t);
@@ -1139,7 +1151,8 @@ struct HeatWatch {
 }
 
 impl Observer<DropSystem, N> for HeatWatch {
-    fn on_step(&mut self, _sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
+    type Halt = Infallible;
+    fn on_step(&mut self, _sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<Infallible> {
         let e = step.dense.y1()[ix::E_FRIC];
         self.max_drop_j = self.max_drop_j.max(self.last - e);
         self.last = e;

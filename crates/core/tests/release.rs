@@ -1,5 +1,6 @@
-//! The optional release state (issue 7): rotor offset and velocity, race spin at release.
-//! Defaults reproduce the MODEL-NOTES release exactly; non-defaults are tested by physics.
+//! The optional release state: rotor offset and velocity, race spin at release. Defaults
+//! reproduce the release of docs/model.md#release-state exactly; non-defaults are tested by
+//! physics.
 
 use std::collections::BTreeSet;
 use whirlmap_core::{simulate, DropOptions, Scene};

@@ -1,6 +1,7 @@
 //! The analytic stiff Jacobian of the drop model (for the linearly implicit stepper) against
 //! central finite differences of the right-hand side, at states taken from real drops.
 
+use std::convert::Infallible;
 use std::ops::ControlFlow;
 use whirlmap_core::model::{ix, DropSystem, Slip, N};
 use whirlmap_core::ode::{Observer, OdeSystem, StepView};
@@ -16,7 +17,8 @@ struct Check {
 }
 
 impl Observer<DropSystem, N> for Check {
-    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
+    type Halt = Infallible;
+    fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<Infallible> {
         self.seen += 1;
         if !self.seen.is_multiple_of(self.every) {
             return ControlFlow::Continue(());

@@ -2,6 +2,7 @@
 //! the default: eq. 7's damper in every direction of the ball set) or on its radial rate only
 //! (`radial_only`, the paper's law read literally).
 
+use std::convert::Infallible;
 use std::ops::ControlFlow;
 use whirlmap_core::model::{ix, DropSystem, N};
 use whirlmap_core::ode::{Observer, StepView};
@@ -61,7 +62,8 @@ struct Ringing {
 }
 
 impl Observer<DropSystem, N> for Ringing {
-    fn on_step(&mut self, _sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<()> {
+    type Halt = Infallible;
+    fn on_step(&mut self, _sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<Infallible> {
         let d = step.dense;
         while self.next <= d.t1() && self.next <= self.t_b {
             if self.next >= d.t0() && self.next >= self.t_a {

@@ -519,11 +519,10 @@ fn quasi_static_race_with_thermal_feedback_closes_the_balances_and_matches_the_f
     // Measured when written (radial-only support damper): rise 12.42 K, coupling error 5.9e-4
     // (the full model's is 4.3e-4), reduced model against the full model 1.03e-2, F_th
     // 804.33 N against 803.30 N; with the isotropic default 5.9e-4, 1.09e-2, 804.33 against
-    // 803.20 N. This
-    // 0.1 s case is all impacts, where the reduced model's forces are about 1 % off (README,
-    // "Speed against accuracy"), and its heat with them; we first wrote 1e-2 for that bound
-    // and widened it to 2e-2 after the measurement. Over a coast-down, where rolling
-    // dominates, the error is 1e-4 of the rise (README, thermal section).
+    // 803.20 N. This 0.1 s case is all impacts, where the reduced model's forces are about
+    // 1 % off (docs/accuracy.md#model-only-what-a-scene-requires), and its heat with them; we
+    // first wrote 1e-2 for that bound and widened it to 2e-2 after the measurement. Over a
+    // coast-down, where rolling dominates, the error is 1e-4 of the rise (docs/thermal.md).
     assert!(e_coupling < 1e-3, "coupling {e_coupling}");
     assert!(e_model < 2e-2, "model {e_model}");
 }

@@ -1261,7 +1261,7 @@ pub fn draw_marked_class_map(
 /// `contours.json` (an ensemble's) exists (then `points.jsonl` is optional). Returns the paths
 /// written.
 pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
-    // An ensemble's results (issue 7): Fig. 4 with probability bands.
+    // An ensemble's results: Fig. 4 with probability bands (docs/probability.md).
     let prob = crate::prob_chart::render_probability(dir)?;
     if !prob.is_empty() && !dir.join(crate::sweep::POINTS_FILE).exists() {
         return Ok(prob);

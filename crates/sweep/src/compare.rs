@@ -41,8 +41,8 @@ pub struct Thresholds {
 
 impl Default for Thresholds {
     /// 5 % for both: far above the solver's own scatter (forces agree to 0.001 % between
-    /// rtol 1e-5 and 1e-9, see the README), well below a design-relevant change. A choice,
-    /// not a measured optimum.
+    /// rtol 1e-5 and 1e-9, docs/clusters.md#compare), well below a design-relevant change.
+    /// A choice, not a measured optimum.
     fn default() -> Self {
         Self {
             force_rel: 0.05,

@@ -3,7 +3,8 @@
 //! typed solver error within its step budget. Never NaN, never a hang.
 //!
 //! The reduced matrix runs in CI (`tests/extremes.rs`); the full one is
-//! `cargo run --release --example extremes`, whose results the README records.
+//! `cargo run --release --example extremes`, whose results
+//! docs/accuracy.md#stability-at-the-extremes records.
 
 use serde::Serialize;
 use std::time::Instant;

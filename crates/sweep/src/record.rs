@@ -1,5 +1,5 @@
 //! The JSON record of one drop. Field names are a contract that later work and users rely on
-//! (see the README's "JSON contract").
+//! (docs/results-format.md).
 
 use crate::classify::{OrbitClass, Reason};
 use serde::{Deserialize, Serialize};

@@ -2,10 +2,10 @@
 //! source, and the catalogue ratings recomputed from the standards' own formulas.
 //!
 //! Sources:
-//! - \[Table 3\] the seed paper's Table 3: 71908, bore 40 mm, outside diameter 62 mm, width
+//! - \[Table 3\] the paper's Table 3: 71908, bore 40 mm, outside diameter 62 mm, width
 //!   12 mm, balls 5.5 mm. The pitch diameter is taken as the mean of bore and outside
 //!   diameter, 51 mm, as the scene's Palmgren drag does (`Scene::pitch_diameter_m`).
-//! - \[Table 4\] the seed paper's Table 4: the lumped race-on-balls stiffness
+//! - \[Table 4\] the paper's Table 4: the lumped race-on-balls stiffness
 //!   `k2 = 2.47e5 N/mm^1.5 = 7.811e9 N/m^1.5`, zero internal clearance.
 //! - \[SKF\] SKF super-precision bearings: suffix CD is the 15° contact angle (ACD is 25°).
 //! - \[ISO 281\] ISO 281:2007, *Rolling bearings — Dynamic load ratings and rating life*:
@@ -124,7 +124,7 @@ impl Default for BearingPair {
 }
 
 impl BearingPair {
-    /// The seed paper's touchdown bearing: two 71908 CD face to face, the defaults of every
+    /// The paper's touchdown bearing: two 71908 CD face to face, the defaults of every
     /// field above.
     pub fn paper_71908_cd() -> Self {
         BearingPair {

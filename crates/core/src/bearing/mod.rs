@@ -20,7 +20,7 @@
 //! - [`analysis`]: the streaming analysis of one drop, and [`assumptions`], the text to print
 //!   beside its numbers.
 //!
-//! ## The numbers for the seed paper's bearing
+//! ## The numbers for the paper's bearing
 //! Per-ball stiffness from `k2 = 7.811e9 N/m^1.5`: `K_n = 8.46e8 N/m^1.5`. By Hertz the same
 //! geometry has `K_n = 7.24e9 N/m^1.5`, a lumped `k2 = 6.69e10 N/m^1.5`: the paper's support is
 //! 8.6 times softer than two rigid-ring 71908 CD (at one force the race moves 4.2 times as

@@ -34,7 +34,8 @@ impl Palmgren {
     }
 
     /// Load part M_1 = f_1 P_1 d_m (N m), eq. 13, with f_1 = 0.001 (P_0 / C_0)^0.33 and
-    /// P_0 = P_1 = `load_n` (the instantaneous ball-support force; MODEL-NOTES).
+    /// P_0 = P_1 = `load_n` (the instantaneous ball-support force;
+    /// docs/model.md#palmgren-load-term).
     #[inline]
     pub fn load_torque_n_m(&self, load_n: f64) -> f64 {
         let p = load_n.max(0.0);

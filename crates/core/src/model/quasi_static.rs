@@ -19,7 +19,7 @@
 //! offset of the race that the friction force would cause. The race keeps its rotation
 //! (inertia `J_b`, friction torque, Palmgren drag with `P1 = F`).
 //!
-//! What it costs in accuracy is measured, not assumed (`whirlmap accuracy`, README).
+//! What it costs in accuracy is measured, not assumed (`whirlmap accuracy`, docs/accuracy.md).
 
 /// The series split of a combined penetration.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,8 +2,8 @@
 //! interpolant, and the accept/reject loop with its step-size law. Each stepper supplies only
 //! its trial step (stages, error norm) and builds its interpolant.
 
-use super::dopri5::{initial_step, Dense, StepControl};
-use super::{OdeSystem, Stats};
+use super::step::{initial_step, Dense, Stats, StepControl};
+use super::system::OdeSystem;
 use crate::error::SolveError;
 
 /// A step-size law (Hairer-Wanner I, II.4 and IV.8): after an attempt with error norm `err`,
@@ -24,7 +24,8 @@ pub(super) struct StepLaw {
     pub fac_max: f64,
 }
 
-/// The state every adaptive stepper keeps besides its stages (see [`super::Stepper::core`]).
+/// The state every adaptive stepper keeps besides its stages (see
+/// [`super::stepper::Stepper::core`]).
 #[derive(Debug, Clone)]
 pub struct StepCore<const N: usize> {
     /// Tolerances, limits and the optional fixed step.

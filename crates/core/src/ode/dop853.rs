@@ -21,8 +21,9 @@
 #![allow(clippy::excessive_precision)]
 
 use super::control::{StepCore, StepLaw};
-use super::dopri5::{Dense, StepControl};
-use super::{OdeSystem, Stepper};
+use super::step::{Dense, StepControl};
+use super::stepper::Stepper;
+use super::system::OdeSystem;
 use crate::error::SolveError;
 
 /// Stages of the step (12) and of the dense output (16).
@@ -361,6 +362,7 @@ mod tests {
     /// x'' = -x; exact solution cos t.
     struct Harmonic;
     impl OdeSystem<2> for Harmonic {
+        type Guard = crate::ode::NoGuard;
         fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
             dy[0] = y[1];
             dy[1] = -y[0];

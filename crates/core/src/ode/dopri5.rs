@@ -5,7 +5,9 @@
 //! G. Wanner, "Solving Ordinary Differential Equations I", 2nd ed., Sec. II.4-II.6 (DOPRI5).
 
 use super::control::{StepCore, StepLaw};
-use super::{OdeSystem, Stepper};
+use super::step::{Dense, StepControl};
+use super::stepper::Stepper;
+use super::system::OdeSystem;
 use crate::error::SolveError;
 
 const C2: f64 = 1.0 / 5.0;
@@ -44,104 +46,6 @@ const D4: f64 = -10690763975.0 / 1880347072.0;
 const D5: f64 = 701980252875.0 / 199316789632.0;
 const D6: f64 = -1453857185.0 / 822651844.0;
 const D7: f64 = 69997945.0 / 29380423.0;
-
-/// Step-size control settings.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepControl<const N: usize> {
-    /// Relative tolerance (dimensionless).
-    pub rtol: f64,
-    /// Absolute tolerance per state component (in that component's unit).
-    pub atol: [f64; N],
-    /// Smallest step before [`SolveError::StepSizeUnderflow`] (s).
-    pub h_min: f64,
-    /// Step attempts (accepted + rejected) before [`SolveError::StepBudget`].
-    pub max_attempts: u64,
-    /// Fixed step size (s) instead of adaptive control: every step is accepted. For
-    /// convergence-order studies; `None` in normal use.
-    pub fixed_step: Option<f64>,
-}
-
-/// The continuous extension of one accepted step, valid on `[t0, t_end]`: DOPRI5's
-/// 4th-order one (5 coefficient vectors) or DOP853's 7th-order one (8).
-///
-/// Both share Hairer's nested form `r0 + th (r1 + th1 (r2 + th (r3 + th1 (r4 + ...))))`
-/// with `th = (t - t0)/h`, `th1 = 1 - th`, so one type serves both steppers.
-#[derive(Debug, Clone)]
-pub struct Dense<const N: usize> {
-    pub(super) t0: f64,
-    pub(super) h: f64,
-    pub(super) t_end: f64,
-    /// Number of coefficient vectors in use: 5 (DOPRI5) or 8 (DOP853).
-    pub(super) terms: usize,
-    pub(super) r: [[f64; N]; 8],
-    /// The step's end state, kept exactly (not re-summed from `r`).
-    pub(super) y1: [f64; N],
-}
-
-impl<const N: usize> Dense<N> {
-    /// Start of the step (s).
-    pub fn t0(&self) -> f64 {
-        self.t0
-    }
-    /// End of the (possibly event-truncated) step (s).
-    pub fn t1(&self) -> f64 {
-        self.t_end
-    }
-    /// State at `t` (meant for `t` in `[t0, t1]`).
-    #[inline]
-    pub fn eval(&self, t: f64) -> [f64; N] {
-        let th = (t - self.t0) / self.h;
-        let th1 = 1.0 - th;
-        let mut y = [0.0; N];
-        let r = &self.r;
-        if self.terms == 5 {
-            for i in 0..N {
-                y[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
-            }
-        } else {
-            for i in 0..N {
-                let inner = r[4][i] + th * (r[5][i] + th1 * (r[6][i] + th * r[7][i]));
-                y[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * inner)));
-            }
-        }
-        y
-    }
-    /// State at the start of the step.
-    pub fn y0(&self) -> [f64; N] {
-        self.r[0]
-    }
-    /// State at the end of the (possibly truncated) step.
-    pub fn y1(&self) -> [f64; N] {
-        if self.t_end == self.t0 + self.h {
-            self.y1
-        } else {
-            self.eval(self.t_end)
-        }
-    }
-}
-
-/// A first step from Hairer's `hinit` (the simple form): 1 % of the ratio of the state's
-/// and the derivative's weighted norms, capped by `max_step` and floored at `10 h_min`.
-pub(super) fn initial_step<const N: usize>(
-    ctl: &StepControl<N>,
-    y: &[f64; N],
-    dy: &[f64; N],
-    max_step: f64,
-) -> f64 {
-    let (mut d0, mut d1) = (0.0, 0.0);
-    for i in 0..N {
-        let sc = ctl.atol[i] + ctl.rtol * y[i].abs();
-        d0 += (y[i] / sc).powi(2);
-        d1 += (dy[i] / sc).powi(2);
-    }
-    let (d0, d1) = ((d0 / N as f64).sqrt(), (d1 / N as f64).sqrt());
-    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
-        1e-6
-    } else {
-        0.01 * d0 / d1
-    };
-    h0.min(max_step).max(ctl.h_min * 10.0)
-}
 
 /// The stepper: stage storage, the FSAL derivative, controller memory and work counters.
 #[derive(Debug, Clone)]
@@ -294,6 +198,7 @@ mod tests {
     /// x'' = -x as a first-order system; exact solution cos t.
     struct Harmonic;
     impl OdeSystem<2> for Harmonic {
+        type Guard = crate::ode::NoGuard;
         fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
             dy[0] = y[1];
             dy[1] = -y[0];
@@ -303,6 +208,7 @@ mod tests {
     /// y' = -2 y; exact solution exp(-2 t).
     struct Decay;
     impl OdeSystem<1> for Decay {
+        type Guard = crate::ode::NoGuard;
         fn rhs(&self, _t: f64, y: &[f64; 1], dy: &mut [f64; 1]) {
             dy[0] = -2.0 * y[0];
         }
@@ -372,6 +278,7 @@ mod tests {
     fn non_finite_rhs_is_a_typed_error_with_time() {
         struct Blow;
         impl OdeSystem<1> for Blow {
+            type Guard = crate::ode::NoGuard;
             fn rhs(&self, t: f64, _y: &[f64; 1], dy: &mut [f64; 1]) {
                 dy[0] = if t > 0.5 { f64::NAN } else { 1.0 };
             }
@@ -398,7 +305,13 @@ mod tests {
     fn event_on_a_falling_ball_is_located_at_the_closed_form_time() {
         // y'' = -g from height 1 m: the guard y crosses zero at sqrt(2/g).
         struct Ball;
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        struct Floor;
+        impl crate::ode::GuardSet for Floor {
+            const ALL: &'static [Self] = &[Floor];
+        }
         impl OdeSystem<2> for Ball {
+            type Guard = Floor;
             fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
                 dy[0] = y[1];
                 dy[1] = -9.81;
@@ -426,7 +339,7 @@ mod tests {
         let mut st = Dopri5::new(ctl);
         let (mut t, mut y) = (0.0, [1.0, 0.0]);
         let stop = integrate(&Ball, &mut st, &mut t, &mut y, 10.0, &mut NoObserver).unwrap();
-        assert_eq!(stop, Stop::Event { index: 0 });
+        assert_eq!(stop, Stop::Event { guard: Floor });
         let exact = (2.0 / 9.81f64).sqrt();
         assert!((t - exact).abs() < 1e-12, "event at {t}, exact {exact}");
         // The run continues just past the crossing, on the new mode's side.

@@ -17,7 +17,9 @@
 //! stage.
 
 use super::control::{StepCore, StepLaw};
-use super::{Dense, OdeSystem, StepControl, Stepper, StiffJacobian, MAX_STIFF};
+use super::step::{Dense, StepControl};
+use super::stepper::Stepper;
+use super::system::{OdeSystem, StiffJacobian, MAX_STIFF};
 use crate::error::SolveError;
 use nalgebra::{DMatrix, DVector, Dyn, Matrix6, LU};
 
@@ -468,6 +470,7 @@ mod tests {
         [1.0e8, 0.0, -1.7e9, -2.0e4],
     ];
     impl OdeSystem<4> for Stiff {
+        type Guard = crate::ode::NoGuard;
         fn rhs(&self, _t: f64, y: &[f64; 4], dy: &mut [f64; 4]) {
             for i in 0..4 {
                 dy[i] = (0..4).map(|j| M[i][j] * y[j]).sum();
@@ -489,6 +492,7 @@ mod tests {
     /// x'' = -x; exact solution cos t.
     struct Harmonic;
     impl OdeSystem<2> for Harmonic {
+        type Guard = crate::ode::NoGuard;
         fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
             dy[0] = y[1];
             dy[1] = -y[0];

@@ -13,7 +13,7 @@
 //!   (engine oil at 300 K: 0.145 W/(m K), 1909 J/(kg K), 884 kg/m^3).
 //! - \[SKF\] SKF rolling bearings catalogue (2018): 71908 CD: d = 40, D = 62, B = 12 mm, contact
 //!   angle 15 deg (suffix CD; ACD is 25 deg); grease fill 25-35 % of the free space.
-//! - [Table 3] the seed paper's Table 3 (71908: 40 x 62 x 12 mm, balls 5.5 mm).
+//! - [Table 3] the paper's Table 3 (71908: 40 x 62 x 12 mm, balls 5.5 mm).
 
 use crate::error::InvalidParameter;
 use serde::{Deserialize, Serialize};

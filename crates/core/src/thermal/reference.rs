@@ -6,11 +6,12 @@
 
 use super::network::NODES;
 use super::ThermalModel;
-use crate::drop::{next_mode, tolerances, STEP_AFTER_SWITCH_S};
+use crate::drop::{jump_rules, tolerances};
 use crate::error::SolveError;
-use crate::model::{ix, DropSystem, N};
+use crate::model::{ix, DropSystem, Guard, Mode, N};
 use crate::ode::{
-    integrate, Dopri5, NoObserver, OdeSystem, Stats, StepControl, Stepper, Stop, MAX_GUARDS,
+    run_hybrid, Dopri5, Finish, Hybrid, NoObserver, OdeSystem, Stats, StepControl, Stepper,
+    MAX_GUARDS,
 };
 use crate::scene::Scene;
 
@@ -37,6 +38,8 @@ impl Coupled<'_> {
 }
 
 impl OdeSystem<NC> for Coupled<'_> {
+    type Guard = Guard;
+
     fn rhs(&self, t: f64, y: &[f64; NC], dy: &mut [f64; NC]) {
         let (s, yd) = self.loaded(y);
         let mut d = [0.0; N];
@@ -55,6 +58,21 @@ impl OdeSystem<NC> for Coupled<'_> {
 
     fn max_step(&self) -> f64 {
         self.sys.max_step()
+    }
+}
+
+/// The dynamic system's modes and jump map, at the thermal load of the temperatures.
+impl Hybrid<NC> for Coupled<'_> {
+    type Mode = Mode;
+    fn mode(&self) -> Mode {
+        self.sys.mode
+    }
+    fn set_mode(&mut self, mode: Mode) {
+        self.sys.mode = mode;
+    }
+    fn jump(&self, guard: Guard, y: &[f64; NC]) -> Mode {
+        let (s, yd) = self.loaded(y);
+        s.jump(guard, &yd)
     }
 }
 
@@ -100,28 +118,17 @@ pub fn simulate_fully_coupled(
     y[..N].copy_from_slice(&y0);
     let mut c = Coupled { sys, model: &model };
     let mut t = 0.0;
-    loop {
-        match integrate(
-            &c,
-            &mut stepper,
-            &mut t,
-            &mut y,
-            duration_s,
-            &mut NoObserver,
-        )? {
-            Stop::EndTime | Stop::Observer => break,
-            Stop::Event { index } => {
-                if stepper.stats().events >= scene.solver.max_events {
-                    return Err(SolveError::EventBudget {
-                        t_s: t,
-                        events: stepper.stats().events,
-                    });
-                }
-                let (s, yd) = c.loaded(&y);
-                c.sys.mode = next_mode(&s, &yd, index);
-                stepper.cap_next_step(STEP_AFTER_SWITCH_S);
-            }
-        }
+    match run_hybrid(
+        &mut c,
+        &mut stepper,
+        &mut t,
+        &mut y,
+        duration_s,
+        &mut NoObserver,
+        &jump_rules(scene),
+    )? {
+        Finish::EndTime => {}
+        Finish::Halted(never) => match never {},
     }
     let mut dt = [0.0; NODES];
     dt.copy_from_slice(&y[N..]);

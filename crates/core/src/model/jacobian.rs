@@ -1,0 +1,176 @@
+//! The stiff part of the model's Jacobian for the linearly implicit stepper (ROS34PW2): the
+//! derivatives of eq. 7's two Hertz contacts and of the friction that follows them (eq. 8),
+//! over the translations, their rates and the two spins.
+
+use super::friction::FrictionSlopes;
+use super::state::{ix, N};
+use super::{hertz, DropSystem};
+use crate::ode::StiffJacobian;
+use nalgebra::{Matrix2, Vector2};
+
+impl DropSystem {
+    /// The stiff part of the Jacobian for the linearly implicit stepper: the two Hertz
+    /// contacts' normal forces (eq. 7, spring and damper, with the turning of the contact
+    /// normal), the friction that follows them (eq. 8; the regularised law's slope in the
+    /// slip velocity too), over the translations, their rates and the two spins. Left out,
+    /// because they are not stiff: gravity, the unbalance terms, Palmgren drag, and the
+    /// sticking constraint's dependence on the state.
+    #[inline]
+    pub(super) fn stiff_jacobian_at(&self, y: &[f64; N]) -> StiffJacobian {
+        use ix::*;
+        // Blocks of the stiff set: rotor position 0..2, race position 2..4, rotor velocity
+        // 4..6, race velocity 6..8, then the rotor's (8) and the race's (9) spin.
+        const QR: usize = 0;
+        const QB: usize = 2;
+        const VR: usize = 4;
+        const VB: usize = 6;
+        const SR: usize = 8;
+        const SB: usize = 9;
+        let mut sj = StiffJacobian::over(&[XR, YR, XB, YB, VXR, VYR, VXB, VYB, WR, WB]);
+        // The four positions' rows are exactly q' = v (eqs. 1-6): the stepper eliminates them.
+        sj.kinematic = 4;
+        let j = &mut sj.jac;
+        j.fixed_view_mut::<4, 4>(QR, VR).fill_with_identity();
+        let f = self.forces(y);
+        // t = R n with R the quarter turn.
+        let quarter = Matrix2::new(0.0, -1.0, 1.0, 0.0);
+        if self.mode.contact && f.dist_m > 0.0 {
+            let (n, t, dist) = (f.n, f.t, f.dist_m);
+            let w = Vector2::new(y[VXR] - y[VXB], y[VYR] - y[VYB]);
+            // P = I - n n^T: how n turns with d; R P: how t turns.
+            let p = Matrix2::identity() - n * n.transpose();
+            let rp = quarter * p;
+            let pw = p * w;
+            let (kd, c) = match &self.series {
+                Some(ss) => {
+                    // Series springs: dF/dd = F / (a/e1 + b/e2); the split damper's weight
+                    // w = (a/e1) / (a/e1 + b/e2) moves with d too (its slope times delta_dot
+                    // joins the stiffness).
+                    let sp = ss.split(f.delta_m);
+                    let (pp, q) = (ss.inv_e1(), ss.inv_e2());
+                    let (a, b, fa) = (sp.delta_m, sp.support_m, sp.force_n.abs());
+                    let denom = a * pp + b * q;
+                    let wc = sp.w_contact;
+                    let c = self.c1 * wc * wc + self.c2 * (1.0 - wc) * (1.0 - wc);
+                    let kd = if denom > 0.0 && fa > 0.0 {
+                        let k = fa / denom;
+                        let dw = pp * q * a * b * (pp - q) * k / (fa * denom * denom);
+                        let dc = 2.0 * (self.c1 * wc - self.c2 * (1.0 - wc)) * dw;
+                        k + dc * f.delta_dot_m_s
+                    } else {
+                        0.0
+                    };
+                    (kd, c)
+                }
+                None => {
+                    let d = f.delta_m.max(0.0);
+                    let kd = if d > 0.0 {
+                        self.k1 * self.e1 * hertz::signed_pow(d, self.e1) / d
+                    } else {
+                        0.0
+                    };
+                    (kd, self.c1)
+                }
+            };
+            let (fnn, ft) = (f.normal_n, f.friction_n);
+            // Gradients of F_n (eq. 7) over d = p_r - p_b and w = v_r - v_b.
+            let dfn_dd = kd * n + (c / dist) * pw;
+            let dfn_dw = c * n;
+            // Friction: d F_t over d, w and the two spins.
+            let (mut dft_dd, mut dft_dw, mut dft_dwr, mut dft_dwb) =
+                (Vector2::zeros(), Vector2::zeros(), 0.0, 0.0);
+            match self.friction.slopes(self.mode.slip, fnn, f.v_rel_m_s) {
+                FrictionSlopes::Smooth {
+                    per_normal,
+                    per_slip_velocity,
+                } => {
+                    // v_rel depends on d through the turning tangent: (R P)^T w / |d|.
+                    let dv_dd = rp.transpose() * w / dist;
+                    dft_dd = per_normal * dfn_dd + per_slip_velocity * dv_dd;
+                    dft_dw = per_normal * dfn_dw + per_slip_velocity * t;
+                    dft_dwr = per_slip_velocity * self.r_r;
+                    dft_dwb = -per_slip_velocity * self.r_b;
+                }
+                FrictionSlopes::Proportional { per_normal } => {
+                    dft_dd = per_normal * dfn_dd;
+                    dft_dw = per_normal * dfn_dw;
+                }
+                FrictionSlopes::Constraint => {}
+            }
+            // Force on the race fc = F_n n + F_t t (the rotor gets -fc), over d and w.
+            let dfc_dd = n * dfn_dd.transpose()
+                + (fnn / dist) * p
+                + t * dft_dd.transpose()
+                + (ft / dist) * rp;
+            let dfc_dw = n * dfn_dw.transpose() + t * dft_dw.transpose();
+            let (ir, ib) = (1.0 / self.m_r, 1.0 / self.m_b);
+            let mut block = |row: usize, col: usize, m: Matrix2<f64>| {
+                let mut v = j.fixed_view_mut::<2, 2>(row, col);
+                v += m;
+            };
+            // Rotor rows: -fc / m_r, with d = p_r - p_b and w = v_r - v_b.
+            block(VR, QR, -dfc_dd * ir);
+            block(VR, VR, -dfc_dw * ir);
+            let race = self.series.is_none();
+            if race {
+                block(VR, QB, dfc_dd * ir);
+                block(VR, VB, dfc_dw * ir);
+                block(VB, QR, dfc_dd * ib);
+                block(VB, QB, -dfc_dd * ib);
+                block(VB, VR, dfc_dw * ib);
+                block(VB, VB, -dfc_dw * ib);
+            }
+            let mut column = |row: usize, col: usize, v: Vector2<f64>| {
+                let mut c = j.fixed_view_mut::<2, 1>(row, col);
+                c += v;
+            };
+            column(VR, SR, -t * (dft_dwr * ir));
+            column(VR, SB, -t * (dft_dwb * ir));
+            if race {
+                column(VB, SR, t * (dft_dwr * ib));
+                column(VB, SB, t * (dft_dwb * ib));
+            }
+            // Spin rows: omega_r' = -F_t r_r / J_r, omega_b' = F_t R_b / J_b.
+            for (row, scale) in [(SR, -self.r_r / self.j_r), (SB, self.r_b / self.j_b)] {
+                let mut r = j.fixed_view_mut::<1, 2>(row, QR);
+                r += scale * dft_dd.transpose();
+                let mut r = j.fixed_view_mut::<1, 2>(row, VR);
+                r += scale * dft_dw.transpose();
+                if race {
+                    let mut r = j.fixed_view_mut::<1, 2>(row, QB);
+                    r -= scale * dft_dd.transpose();
+                    let mut r = j.fixed_view_mut::<1, 2>(row, VB);
+                    r -= scale * dft_dw.transpose();
+                }
+                j[(row, SR)] += scale * dft_dwr;
+                j[(row, SB)] += scale * dft_dwb;
+            }
+        }
+        if self.series.is_none() && self.mode.support {
+            let b = Vector2::new(y[XB], y[YB]);
+            let r = b.norm();
+            if r > 0.0 {
+                let nb = b / r;
+                let vb = Vector2::new(y[VXB], y[VYB]);
+                let vn = vb.dot(&nb);
+                let pb = Matrix2::identity() - nb * nb.transpose();
+                let pv = pb * vb;
+                let kd = self.k2 * self.e2 * hertz::signed_pow(r, self.e2) / r;
+                let fs = f.support_n;
+                // The support's force -F_s nb (eq. 7, radial) and its radial damper, over the
+                // race position and velocity; then the tangential damper -c2_t (v - nb (nb.v))
+                // and its turning with nb.
+                let dp = nb * (kd * nb + (self.c2 / r) * pv).transpose() + (fs / r) * pb;
+                let ib = 1.0 / self.m_b;
+                let tangential_dq = self.c2_t * (pb * vn + nb * pv.transpose()) / (r * self.m_b);
+                let mut q = j.fixed_view_mut::<2, 2>(VB, QB);
+                q -= dp * ib;
+                q += tangential_dq;
+                let mut v = j.fixed_view_mut::<2, 2>(VB, VB);
+                v -= (self.c2 * ib) * nb * nb.transpose();
+                v -= (self.c2_t * ib) * pb;
+            }
+        }
+        sj
+    }
+}

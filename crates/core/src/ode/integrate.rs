@@ -1,0 +1,135 @@
+//! The driver: steps a system towards an end time, locates guard crossings on each step's
+//! interpolant, and shows every accepted step to an observer, which may stop the run.
+
+use super::events::locate_crossing;
+use super::step::Dense;
+use super::stepper::Stepper;
+use super::system::{GuardSet, OdeSystem, MAX_GUARDS};
+use crate::error::SolveError;
+use std::ops::ControlFlow;
+
+/// One accepted step, as observers see it.
+pub struct StepView<'a, const N: usize> {
+    /// The step's interpolant over `[t0, t1]`.
+    pub dense: &'a Dense<N>,
+}
+
+/// Receives every accepted step; may ask the integrator to stop, and says why.
+pub trait Observer<S, const N: usize> {
+    /// Why this observer stops a run ([`std::convert::Infallible`] if it never does); the
+    /// driver hands it back in [`Stop::Halted`].
+    type Halt;
+    /// Called once per accepted (possibly event-truncated) step.
+    fn on_step(&mut self, _sys: &S, _step: &StepView<'_, N>) -> ControlFlow<Self::Halt> {
+        ControlFlow::Continue(())
+    }
+}
+
+/// An observer that does nothing.
+pub struct NoObserver;
+impl<S, const N: usize> Observer<S, N> for NoObserver {
+    type Halt = std::convert::Infallible;
+}
+
+/// Why [`integrate`] returned: `G` is the system's guard set, `H` the observer's halt reason.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stop<G, H> {
+    /// The end time was reached.
+    EndTime,
+    /// A guard crossed to `<= 0`; the returned state is just past the crossing.
+    Event {
+        /// Which guard of the mode fired.
+        guard: G,
+    },
+    /// The observer returned `ControlFlow::Break(halt)`.
+    Halted(H),
+}
+
+/// Integrates `sys` from `(t, y)` towards `t_end`, advancing `t` and `y` in place.
+///
+/// The step stops exactly at `t_end`, at a located guard crossing, or where an observer
+/// breaks. `stepper` keeps its step-size history across calls; after an event the caller
+/// changes the system's mode, and the next call restarts the step from a fresh RHS value.
+pub fn integrate<S, O, M, const N: usize>(
+    sys: &S,
+    stepper: &mut M,
+    t: &mut f64,
+    y: &mut [f64; N],
+    t_end: f64,
+    observer: &mut O,
+) -> Result<Stop<S::Guard, O::Halt>, SolveError>
+where
+    S: OdeSystem<N>,
+    O: Observer<S, N>,
+    M: Stepper<N>,
+{
+    stepper.restart(sys, *t, y);
+    let mut g0 = [0.0; MAX_GUARDS];
+    let mut g1 = [0.0; MAX_GUARDS];
+    let ng = sys.guards(*t, y, &mut g0);
+    debug_assert!(ng <= S::Guard::ALL.len() && S::Guard::ALL.len() <= MAX_GUARDS);
+    while *t < t_end {
+        let h_cap = sys.max_step_at(*t, y).min(t_end - *t);
+        let dense = stepper.step(sys, *t, y, h_cap)?;
+        let t1 = dense.t1();
+        let y1 = dense.y1();
+        sys.guards(t1, &y1, &mut g1);
+        // Guards are also checked at the step's midpoint on the interpolant, so a mode that
+        // ends and resumes inside one step (a grazing contact that opens and closes again)
+        // is not missed; a crossing in the first half wins over one in the second.
+        let tm = 0.5 * (dense.t0() + t1);
+        let mut gm = [0.0; MAX_GUARDS];
+        sys.guards(tm, &dense.eval(tm), &mut gm);
+        let guard_at = |i: usize, tt: f64| {
+            let mut g = [0.0; MAX_GUARDS];
+            sys.guards(tt, &dense.eval(tt), &mut g);
+            g[i]
+        };
+        // Earliest guard to cross to <= 0 within the step.
+        let mut first: Option<(usize, f64, f64)> = None;
+        for i in 0..ng {
+            if g0[i] <= 0.0 {
+                continue;
+            }
+            let bracket = if gm[i] <= 0.0 {
+                Some((dense.t0(), tm, g0[i], gm[i]))
+            } else if g1[i] <= 0.0 {
+                Some((tm, t1, gm[i], g1[i]))
+            } else {
+                None
+            };
+            if let Some((a, b, ga, gb)) = bracket {
+                let (lo, hi) = locate_crossing(|tt| guard_at(i, tt), a, b, ga, gb);
+                if first.is_none_or(|(_, _, h)| hi < h) {
+                    first = Some((i, lo, hi));
+                }
+            }
+        }
+        match first {
+            Some((index, _lo, hi)) => {
+                stepper.count_event();
+                let cut = stepper.cut_last_step(hi);
+                *t = hi;
+                *y = cut.y1();
+                let view = StepView { dense: cut };
+                // The observer sees the step up to the event; a break here is moot.
+                let _ = observer.on_step(sys, &view);
+                return Ok(Stop::Event {
+                    guard: S::Guard::ALL[index],
+                });
+            }
+            None => {
+                *t = t1;
+                *y = y1;
+                g0 = g1;
+                let view = StepView {
+                    dense: stepper.last_dense(),
+                };
+                if let ControlFlow::Break(halt) = observer.on_step(sys, &view) {
+                    return Ok(Stop::Halted(halt));
+                }
+            }
+        }
+    }
+    Ok(Stop::EndTime)
+}

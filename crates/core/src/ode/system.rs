@@ -1,0 +1,97 @@
+//! What a problem is to the integrator: a right-hand side, step bounds, guard functions and an
+//! optional stiff Jacobian. Nothing here knows the steppers.
+
+use std::fmt::Debug;
+
+/// Most guard functions one mode of a system may declare.
+pub const MAX_GUARDS: usize = 4;
+
+/// The named guard functions of a system: one value per guard, each with a fixed index, its
+/// slot in the array [`OdeSystem::guards`] fills. The driver reports a crossing as the guard
+/// that crossed, so a caller matches on names, not on slot numbers.
+pub trait GuardSet: Copy + Debug + PartialEq + 'static {
+    /// Every guard in index order: guard `ALL[i]` is written into `g[i]`. At most
+    /// [`MAX_GUARDS`] of them.
+    const ALL: &'static [Self];
+}
+
+/// The guard set of a system without discrete modes: it has no guard at all.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoGuard {}
+
+impl GuardSet for NoGuard {
+    const ALL: &'static [Self] = &[];
+}
+
+/// Most state components an approximate (stiff) Jacobian may couple.
+pub const MAX_STIFF: usize = 10;
+
+/// The matrix of a [`StiffJacobian`] (nalgebra's fixed-size storage).
+pub type JacobianMatrix = nalgebra::SMatrix<f64, MAX_STIFF, MAX_STIFF>;
+
+/// An approximate Jacobian restricted to a few state components, for the linearly implicit
+/// stepper ([`super::Ros34pw2`]): `jac[(a, b)]` approximates `d f_{idx[a]} / d y_{idx[b]}`; every
+/// entry outside these rows and columns is taken as zero.
+#[derive(Debug, Clone, Copy)]
+pub struct StiffJacobian {
+    /// The coupled components (the first `len` entries are used).
+    pub idx: [usize; MAX_STIFF],
+    /// How many components are coupled.
+    pub len: usize,
+    /// The restricted Jacobian (1/s units of the state's components).
+    pub jac: JacobianMatrix,
+    /// How many leading components are *kinematic*: positions `q_a` (a < `kinematic`) whose
+    /// rows say exactly `q_a' = y_{idx[kinematic + a]}` (`jac[(a, kinematic + a)] = 1`, every
+    /// other entry of the row zero). The stepper then eliminates them and factors only the
+    /// remaining `len - kinematic` components (a Schur complement). 0 (the default of
+    /// [`StiffJacobian::over`]): no such structure is claimed. At most `len / 2`.
+    pub kinematic: usize,
+}
+
+impl StiffJacobian {
+    /// An empty Jacobian over the components `idx` (at most [`MAX_STIFF`]).
+    pub fn over(idx: &[usize]) -> Self {
+        let mut s = Self {
+            idx: [0; MAX_STIFF],
+            len: idx.len(),
+            jac: JacobianMatrix::zeros(),
+            kinematic: 0,
+        };
+        s.idx[..idx.len()].copy_from_slice(idx);
+        s
+    }
+}
+
+/// A first-order system `y' = f(t, y)` with a fixed-size state and mode guards.
+pub trait OdeSystem<const N: usize> {
+    /// The system's guards by name ([`NoGuard`] for a system without modes).
+    type Guard: GuardSet;
+
+    /// Writes `f(t, y)` into `dy`.
+    fn rhs(&self, t: f64, y: &[f64; N], dy: &mut [f64; N]);
+
+    /// Writes the current mode's guard values into `g` and returns how many are active: the
+    /// first `n` of [`GuardSet::ALL`], guard `ALL[i]` in `g[i]`. Each guard is positive while
+    /// the mode holds; a crossing to `<= 0` is an event. The default has none.
+    fn guards(&self, _t: f64, _y: &[f64; N], _g: &mut [f64; MAX_GUARDS]) -> usize {
+        0
+    }
+
+    /// Largest step allowed in the current mode (s); `f64::INFINITY` for none.
+    fn max_step(&self) -> f64 {
+        f64::INFINITY
+    }
+
+    /// Largest step allowed from state `(t, y)` (s); by default [`OdeSystem::max_step`].
+    fn max_step_at(&self, _t: f64, _y: &[f64; N]) -> f64 {
+        self.max_step()
+    }
+
+    /// An approximation of the stiff part of the Jacobian at `(t, y)`, for the linearly
+    /// implicit stepper. It need not be exact (a W-method keeps its order for any matrix); it
+    /// must hold the terms that make the system stiff. The default, `None`, is the zero
+    /// matrix, which turns [`super::Ros34pw2`] into an explicit 3rd-order Runge-Kutta method.
+    fn stiff_jacobian(&self, _t: f64, _y: &[f64; N]) -> Option<StiffJacobian> {
+        None
+    }
+}
