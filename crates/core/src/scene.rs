@@ -31,6 +31,7 @@ pub enum FrictionLaw {
 pub enum Method {
     /// Dormand-Prince 5(4) with 4th-order dense output: the pair of the `standard` (the
     /// scene default) and `reference` fidelities.
+    #[default]
     Dopri5,
     /// Hairer's DOP853, 8(5,3) with 7th-order dense output: the independent reference of
     /// `whirlmap accuracy` (see `ode/dop853.rs` for why it is hand-written).
@@ -38,7 +39,6 @@ pub enum Method {
     /// ROS34PW2, a linearly implicit Rosenbrock-W method of order 3 (Rang and Angermann
     /// 2005) with an analytic stiff Jacobian: its step is not bounded by the light race's
     /// contact mode (`ode/rosw.rs`). The `draft` fidelity's.
-    #[default]
     Ros34pw2,
 }
 
