@@ -6,23 +6,36 @@
 //! order. Its bytes depend only on the spec: identical for any thread count (wall times go
 //! to `timings.jsonl`).
 //!
+//! ## Parallel runs, records in grid order
+//! The owned points of the grid (all of them, or a shard's) run by work stealing
+//! ([`crate::ordered`]): each of the pool's threads takes the next point not yet taken when
+//! it is free, so a slow point holds up only its own thread, never a batch. The calling thread
+//! is the writer: it keeps the records that finish early in a reorder buffer and appends every
+//! contiguous run of them to `points.jsonl` and `timings.jsonl` in grid order, so the file is
+//! the same for any thread count. Workers run at most `8 x threads` points ahead of the first
+//! point not yet written, which bounds the buffer however slow one point is.
+//!
 //! ## Crash safety and resume
-//! The grid runs in chunks of `4 x threads` points; within a chunk points run in parallel and
-//! their lines are appended in grid order, each line with a single `write_all`, then flushed
-//! and synced to disk (`fsync`) when the chunk ends. A kill, or a power loss, loses at most
-//! the chunk in flight. `resume` reads the existing file, drops a torn last line (truncating
-//! the file back to the last complete line), skips points recorded `ok` at their grid index,
-//! re-runs failed ones, and at the end rewrites the file in grid order with one line per
-//! point, so it is byte-identical to an uninterrupted run.
+//! Each run of records is appended with a single `write_all` per file and flushed at once; a
+//! kill loses only the points in flight and those done but waiting in the reorder buffer
+//! behind a slower one (at most `8 x threads`). `points.jsonl` is synced to disk (`fsync`) as
+//! soon as its first records are written, then at most a second apart while records come in
+//! (and a second after the last one when no more come), and at the end: a power loss loses at
+//! most the last second's records. `resume` reads the existing file, drops a torn last line
+//! (truncating the file back to the last complete line), skips points recorded `ok` at their
+//! grid index, re-runs failed ones, and at the end rewrites the file in grid order with one
+//! line per point, so it is byte-identical to an uninterrupted run.
 //!
 //! ## The folder
 //! A run takes the folder's lock, refuses a folder holding another run's files unless told
 //! to resume (the same spec and build only) or overwrite, and lists every file it writes in
-//! `manifest.json` ([`crate::folder`]).
+//! `manifest.json` ([`crate::folder`]). An overwritten run's files are deleted once the new
+//! run's first records are synced.
 //!
 //! ## Memory
-//! Grid points are built from their index chunk by chunk ([`crate::spec::Grid`]); nothing
-//! the size of the grid is held but, on a resume, the records read back.
+//! Grid points are built from their index when a worker takes them ([`crate::spec::Grid`]);
+//! nothing the size of the grid is held but, on a resume, the records read back and those
+//! written since.
 
 use crate::folder::{self, FileEntry, Mode, RunFolder, RunIdentity};
 use crate::ordered::{run_ordered, OrderedSink};
@@ -241,7 +254,7 @@ pub struct RunOptions {
     /// `ok` points.
     pub resume: bool,
     /// Replace the run recorded in the folder (its files are moved to
-    /// [`folder::PREVIOUS_DIR`] until the first chunk of records is written).
+    /// [`folder::PREVIOUS_DIR`] until the first records are written and synced).
     pub overwrite: bool,
     /// Progress display.
     pub progress: ProgressMode,
