@@ -202,7 +202,7 @@ fn resume_refuses_an_edited_spec_and_says_what_changed() {
 }
 
 #[test]
-fn a_rerun_is_refused_and_an_overwrite_keeps_the_old_records_until_its_first_chunk() {
+fn a_rerun_is_refused_and_an_overwrite_keeps_the_old_records_until_its_first_records() {
     let dir = temp_dir("rerun");
     let (tiny, slow) = (spec_file(&dir, "tiny", TINY), spec_file(&dir, "slow", SLOW));
     let out = dir.join("out");
@@ -222,7 +222,7 @@ fn a_rerun_is_refused_and_an_overwrite_keeps_the_old_records_until_its_first_chu
         );
         assert!(std::fs::read(out.join("points.jsonl")).unwrap() == old);
     }
-    // An overwrite killed before its first chunk: the old records are kept aside.
+    // An overwrite killed before its first records: the old records are kept aside.
     let mut child = spawn_sweep(&slow, &out, &["--overwrite"]);
     wait_until(&mut child, "the overwrite took its folder", || {
         manifest_names(&out, "slow")
@@ -234,14 +234,21 @@ fn a_rerun_is_refused_and_an_overwrite_keeps_the_old_records_until_its_first_chu
         std::fs::read(&kept).unwrap() == old,
         "the old records are not kept in previous-run/"
     );
-    // Killed again before a chunk: still kept (not replaced by the empty records).
+    // Killed again before its first record: still kept (not replaced by the empty records).
+    let started = read_json(&out.join("manifest.json"))["started_unix_s"].clone();
     let mut child = spawn_sweep(&slow, &out, &["--overwrite"]);
-    let pid = format!("pid {}:", child.id());
-    wait_until(&mut child, "the second overwrite took its folder", || {
-        std::fs::read_to_string(out.join(".whirlmap.lock")).is_ok_and(|t| t.starts_with(&pid))
-    });
-    // Its preparation takes milliseconds, its first chunk of four slow drops seconds.
-    std::thread::sleep(Duration::from_millis(300));
+    // Its manifest is written once the folder is prepared (milliseconds); its first record
+    // is a slow drop (about half a second) away.
+    wait_until(
+        &mut child,
+        "the second overwrite prepared its folder",
+        || {
+            std::fs::read_to_string(out.join("manifest.json"))
+                .ok()
+                .and_then(|t| serde_json::from_str::<Value>(&t).ok())
+                .is_some_and(|m| m["started_unix_s"] != started)
+        },
+    );
     assert!(child.try_wait().unwrap().is_none());
     child.kill().unwrap();
     child.wait().unwrap();

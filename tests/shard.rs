@@ -323,8 +323,8 @@ fn a_killed_shard_is_reported_then_resumes_without_duplicates_or_losses() {
     full_run(&spec, &single);
     let mut shards = run_shards(&spec, &dir, 4);
 
-    // Shard 0 again, killed once its records are in (its 3 points run as one chunk on one
-    // thread; its critical search, about 17 drops, and its orbit panel are still to go).
+    // Shard 0 again, killed once some of its records are in (its 3 points run on one thread;
+    // its critical search, about 17 drops, and its orbit panel are still to go).
     let killed = dir.join("killed-0");
     let mut child = Command::new(BIN)
         .args([

@@ -1,5 +1,5 @@
 //! End-to-end tests of `whirlmap sweep`: spec errors, determinism across thread counts,
-//! crash-safe resume, and failed points recorded as data.
+//! crash-safe resume (of one thread and of several), and failed points recorded as data.
 
 mod common;
 use common::*;
@@ -184,7 +184,7 @@ fn a_killed_sweep_resumes_to_the_uninterrupted_file() {
     std::fs::write(&spec, RESUME_SPEC).unwrap();
     let (full, killed) = (dir.join("full"), dir.join("killed"));
 
-    // Interrupted run: one thread, chunks of 4; kill once some but not all lines are in.
+    // Interrupted run: one thread; kill once some but not all lines are in.
     let mut child = Command::new(BIN)
         .args([
             "sweep",
@@ -324,5 +324,122 @@ fn a_failed_point_is_recorded_and_the_sweep_goes_on() {
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert_eq!(lines(&out.join("points.jsonl")).len(), 4);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Points of very different cost, interleaved along the grid: in every row of four, the
+/// first drop (rtol 1e-10) takes some 30 times as long as the other three. With more than one
+/// thread the cheap points finish before the dear one before them.
+const UNEVEN_SPEC: &str = r#"{
+  "name": "uneven",
+  "scene": {"classification": {"max_extension_s": 0}},
+  "duration_s": 0.2,
+  "axes": {"speed_rpm": [3000, 5000, 7000, 9000, 11000, 13000],
+           "solver.rtol": [1e-10, 1e-4, 1e-5, 1e-6]}
+}"#;
+
+/// The `index` of every line of a records file, in file order.
+fn indices(path: &Path) -> Vec<u64> {
+    lines(path)
+        .iter()
+        .map(|r| r["index"].as_u64().expect("an index"))
+        .collect()
+}
+
+#[test]
+fn uneven_points_give_the_same_bytes_on_one_two_and_three_threads() {
+    let dir = temp_dir("uneven");
+    let spec = dir.join("uneven.json");
+    std::fs::write(&spec, UNEVEN_SPEC).unwrap();
+    let mut points = Vec::new();
+    let mut summaries = Vec::new();
+    for threads in ["1", "2", "3"] {
+        let out = dir.join(format!("t{threads}"));
+        let o = whirlmap(&[
+            "sweep",
+            s(&spec),
+            "--out",
+            s(&out),
+            "--threads",
+            threads,
+            "--no-progress",
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{threads}: {}", stderr(&o));
+        let grid_order: Vec<u64> = (0..24).collect();
+        assert_eq!(indices(&out.join("points.jsonl")), grid_order, "{threads}");
+        // Wall times differ from run to run; their order is the grid's too.
+        assert_eq!(indices(&out.join("timings.jsonl")), grid_order, "{threads}");
+        points.push(std::fs::read(out.join("points.jsonl")).unwrap());
+        summaries.push(std::fs::read(out.join("summary.csv")).unwrap());
+    }
+    assert!(points[0] == points[1], "points.jsonl: 1 vs 2 threads");
+    assert!(points[0] == points[2], "points.jsonl: 1 vs 3 threads");
+    assert!(summaries[0] == summaries[1] && summaries[0] == summaries[2]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_killed_run_on_three_threads_holds_a_grid_prefix_and_resumes_to_the_same_bytes() {
+    let dir = temp_dir("kill3");
+    let spec = dir.join("uneven.json");
+    std::fs::write(&spec, UNEVEN_SPEC).unwrap();
+    let (full, killed) = (dir.join("full"), dir.join("killed"));
+    let mut child = Command::new(BIN)
+        .args([
+            "sweep",
+            s(&spec),
+            "--out",
+            s(&killed),
+            "--threads",
+            "3",
+            "--no-progress",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let points = killed.join("points.jsonl");
+    let start = Instant::now();
+    loop {
+        let n = std::fs::read_to_string(&points)
+            .map(|t| t.matches('\n').count())
+            .unwrap_or(0);
+        if n >= 2 {
+            assert!(n < 24, "the sweep finished before it could be killed");
+            child.kill().unwrap();
+            break;
+        }
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the sweep ended before writing 2 lines"
+        );
+        assert!(start.elapsed() < Duration::from_secs(60), "no progress");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.wait().unwrap();
+    // Whatever finished out of order, the file holds the first points of the grid, in order,
+    // each once.
+    let got = indices(&points);
+    assert!((2..24).contains(&got.len()), "{} lines", got.len());
+    assert_eq!(got, (0..got.len() as u64).collect::<Vec<_>>());
+    let timings = indices(&killed.join("timings.jsonl"));
+    assert_eq!(timings, got, "timings.jsonl follows points.jsonl");
+
+    for (out, extra) in [
+        (&killed, &["--threads", "2", "--resume"][..]),
+        (&full, &["--threads", "1"][..]),
+    ] {
+        let mut args = vec!["sweep", s(&spec), "--out", s(out), "--no-progress"];
+        args.extend_from_slice(extra);
+        let o = whirlmap(&args);
+        assert_eq!(o.status.code(), Some(0), "{extra:?}: {}", stderr(&o));
+    }
+    assert!(
+        std::fs::read(&points).unwrap() == std::fs::read(full.join("points.jsonl")).unwrap(),
+        "resumed points.jsonl differs from the uninterrupted run's"
+    );
+    let m = read_json(&killed.join("manifest.json"));
+    assert_eq!(m["counts"]["skipped"], got.len());
+    assert_eq!(m["counts"]["ok"], 24);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -485,7 +485,7 @@ fn evaluate_points(spec: &EnsembleSpec, cells: &[&Cell]) -> Vec<f64> {
             .collect(),
         Some(params) => {
             let owned: Vec<Cell> = cells.iter().map(|c| (*c).clone()).collect();
-            let members = ensemble::run_members(params, &owned, spec.duration_s, &mut |_, _| {});
+            let members = ensemble::run_members(params, &owned, spec.duration_s, &|_, _| {});
             members
                 .chunks(params.members)
                 .zip(&owned)

@@ -6,11 +6,12 @@
 //! 1. **Scan on an absolute speed lattice**: every multiple of `resolution_rpm` in
 //!    `[from_rpm, to_rpm]`, plus the two range ends. The lattice is aligned to multiples of
 //!    the resolution, not to the range ends, so two searches over different ranges drop the
-//!    same speeds where their ranges overlap. The scans of all friction coefficients run as
-//!    one parallel batch.
+//!    same speeds where their ranges overlap. The friction coefficients, and the drops of
+//!    each scan, run in parallel.
 //! 2. **Every class transition** between neighbouring successful scan points (whirl on one
-//!    side, no whirl on the other) is **bisected** to `tol_rpm`; the bisections of all
-//!    transitions of all friction coefficients run in parallel.
+//!    side, no whirl on the other) is **bisected** to `tol_rpm`. A coefficient's transitions
+//!    are bisected in parallel as soon as its scan is done, while the other coefficients'
+//!    scans go on (a bisection is a chain of drops, each placed by the one before).
 //! 3. **Report** per friction coefficient a [`CriticalRow`]: the onset (the whirl side of the
 //!    lowest transition into whirl; the lowest scan speed when the range already whirls
 //!    there), its bracket and the classes on each side, every whirl interval found, and
@@ -623,14 +624,13 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
     }
 }
 
-/// A transition waiting to be bisected: the coefficient's index, its two sides, and the scan
-/// speeds that failed (not to be run again).
-type Pending = (usize, (f64, OrbitClass), (f64, OrbitClass), Vec<f64>);
-
 /// Searches `n` friction coefficients at once: `classify_at(j, speed)` classifies a drop of
-/// coefficient `j`. All scans run as one parallel batch, then all bisections; the results
-/// are in the order of `j` and do not depend on the thread count. Invalid settings run
-/// nothing (validate first with [`CriticalOptions::validate`]).
+/// coefficient `j`. The coefficients run in parallel and so do the drops of each scan; each
+/// coefficient's transitions are bisected (in parallel) as soon as its own scan is done, while
+/// the other scans go on, so no thread waits for a barrier between the scans and the
+/// bisections. The results are in the order of `j` and do not depend on the thread count
+/// (each is a function of the drops' outcomes only). Invalid settings run nothing (validate
+/// first with [`CriticalOptions::validate`]).
 pub fn search_all<F: Fn(usize, f64) -> Outcome + Sync>(
     classify_at: F,
     n: usize,
@@ -638,50 +638,26 @@ pub fn search_all<F: Fn(usize, f64) -> Outcome + Sync>(
 ) -> Result<Vec<SearchResult>, InvalidParameter> {
     o.validate()?;
     let speeds = o.scan_speeds();
-    let jobs: Vec<(usize, f64)> = (0..n)
-        .flat_map(|j| speeds.iter().map(move |&s| (j, s)))
-        .collect();
-    let outcomes: Vec<Outcome> = jobs.par_iter().map(|&(j, s)| classify_at(j, s)).collect();
-    let scans: Vec<Vec<Probe>> = outcomes
-        .chunks(speeds.len())
-        .map(|c| {
-            speeds
-                .iter()
-                .zip(c)
-                .map(|(&s, o)| Probe::new(s, o))
-                .collect()
-        })
-        .collect();
-    // Every transition of every coefficient, bisected in parallel.
-    let pending: Vec<Pending> = scans
-        .iter()
-        .enumerate()
-        .flat_map(|(j, scan)| {
+    Ok((0..n)
+        .into_par_iter()
+        .map(|j| {
+            let scan: Vec<Probe> = speeds
+                .par_iter()
+                .map(|&s| Probe::new(s, &classify_at(j, s)))
+                .collect();
+            // The scan speeds that failed are not run again by a bisection.
             let failed: Vec<f64> = scan
                 .iter()
                 .filter(|p| p.error.is_some())
                 .map(|p| p.speed_rpm)
                 .collect();
-            transitions_of(scan)
-                .into_iter()
-                .map(move |(lo, hi)| (j, lo, hi, failed.clone()))
+            let f = |s: f64| classify_at(j, s);
+            let transitions: Vec<Transition> = transitions_of(&scan)
+                .into_par_iter()
+                .map(|(lo, hi)| bisect(&f, lo, hi, o.tol_rpm, &failed))
+                .collect();
+            assemble(o, scan, transitions)
         })
-        .collect();
-    let bisected: Vec<(usize, Transition)> = pending
-        .par_iter()
-        .map(|(j, lo, hi, failed)| {
-            let f = |s: f64| classify_at(*j, s);
-            (*j, bisect(&f, *lo, *hi, o.tol_rpm, failed))
-        })
-        .collect();
-    let mut per_mu: Vec<Vec<Transition>> = vec![Vec::new(); n];
-    for (j, t) in bisected {
-        per_mu[j].push(t);
-    }
-    Ok(scans
-        .into_iter()
-        .zip(per_mu)
-        .map(|(scan, ts)| assemble(o, scan, ts))
         .collect())
 }
 

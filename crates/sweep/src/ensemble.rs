@@ -62,6 +62,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::Scene;
@@ -714,29 +716,28 @@ pub fn run_member(
 }
 
 /// Runs every member of `cells` in parallel on the current rayon pool and returns the
-/// records in (cell, member) order, whatever the thread count. `progress` is called with
-/// (members done, members in all) after each chunk.
+/// records in (cell, member) order, whatever the thread count. The members are one pool of
+/// work (no batches: a thread that is free takes the next member), so a slow drop holds up
+/// only its own thread. `progress` is called, from the worker threads, with (members done,
+/// members in all) after each member.
 pub fn run_members(
     params: &EnsembleParams,
     cells: &[Cell],
     duration_s: f64,
-    progress: &mut dyn FnMut(usize, usize),
+    progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<MemberRecord> {
-    let jobs: Vec<(&Cell, usize)> = cells
-        .iter()
-        .flat_map(|c| (0..params.members).map(move |m| (c, m)))
-        .collect();
-    let chunk = (8 * rayon::current_num_threads()).max(1);
-    let mut out = Vec::with_capacity(jobs.len());
-    for batch in jobs.chunks(chunk) {
-        let recs: Vec<MemberRecord> = batch
-            .par_iter()
-            .map(|(c, m)| run_member(params, c, *m, duration_s))
-            .collect();
-        out.extend(recs);
-        progress(out.len(), jobs.len());
-    }
-    out
+    let members = params.members;
+    let total = cells.len() * members;
+    let done = AtomicUsize::new(0);
+    // Every record is kept for the statistics anyway: collect in order, no writer needed.
+    (0..total)
+        .into_par_iter()
+        .map(|k| {
+            let r = run_member(params, &cells[k / members], k % members, duration_s);
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            r
+        })
+        .collect()
 }
 
 /// One crossing level of a contour group.
@@ -954,12 +955,6 @@ pub fn run_ensemble(
     threads: Option<usize>,
     show_progress: bool,
 ) -> Result<EnsembleOutcome, SweepError> {
-    let cells = spec.cells()?;
-    let params = spec
-        .ensemble
-        .as_ref()
-        .ok_or_else(|| invalid("ensemble", "(missing)", "an ensemble section"))?;
-    check_output_dir(out_dir)?;
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
         builder = builder.num_threads(n);
@@ -967,11 +962,31 @@ pub fn run_ensemble(
     let pool = builder
         .build()
         .map_err(|e| SweepError::ThreadPool(e.to_string()))?;
+    pool.install(|| run_ensemble_here(spec, out_dir, show_progress))
+}
+
+/// [`run_ensemble`] on the current rayon pool (so it can share a pool with other work, as a
+/// sweep's extras do).
+pub fn run_ensemble_here(
+    spec: &EnsembleSpec,
+    out_dir: &Path,
+    show_progress: bool,
+) -> Result<EnsembleOutcome, SweepError> {
+    let cells = spec.cells()?;
+    let params = spec
+        .ensemble
+        .as_ref()
+        .ok_or_else(|| invalid("ensemble", "(missing)", "an ensemble section"))?;
+    check_output_dir(out_dir)?;
     let start = Instant::now();
-    let mut last = Instant::now();
-    let mut progress = |done: usize, total: usize| {
-        if show_progress && (last.elapsed() >= Duration::from_secs(5) || done == total) {
-            last = Instant::now();
+    let last = Mutex::new(Instant::now());
+    let progress = |done: usize, total: usize| {
+        if !show_progress {
+            return;
+        }
+        let mut last = last.lock().unwrap_or_else(|e| e.into_inner());
+        if last.elapsed() >= Duration::from_secs(5) || done == total {
+            *last = Instant::now();
             crate::sweep::progress_line(&format!(
                 "ensemble {}: {done}/{total} drops, {:.0} s",
                 spec.name,
@@ -979,7 +994,7 @@ pub fn run_ensemble(
             ));
         }
     };
-    let members = pool.install(|| run_members(params, &cells, spec.duration_s, &mut progress));
+    let members = run_members(params, &cells, spec.duration_s, &progress);
     let z = z_for_confidence(params.confidence);
     let stats: Vec<CellStats> = cells
         .iter()
@@ -1018,7 +1033,7 @@ pub fn run_ensemble(
         "spec": spec,
         "whirlmap_version": env!("CARGO_PKG_VERSION"),
         "model_version": whirlmap_core::MODEL_VERSION,
-        "threads": pool.current_num_threads(),
+        "threads": rayon::current_num_threads(),
         "cells": cells.len(),
         "drops": members.len(),
         "failed": failed,

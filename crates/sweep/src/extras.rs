@@ -58,9 +58,11 @@ pub struct ExtrasWritten {
     pub probability: Option<PathBuf>,
 }
 
-/// Runs every extra on `threads` worker threads (rayon's default when `None`), as the grid
-/// did: the critical search, the orbits, then the probability ensemble (with progress lines
-/// when `progress`).
+/// Runs every extra on one pool of `threads` worker threads (rayon's default when `None`), as
+/// the grid did: the critical search, the orbits and the probability ensemble (with progress
+/// lines when `progress`) all at once, so each fills the threads the others leave idle
+/// (a bisection's last drops, the orbit drops). Each writes its own files, whose bytes do not
+/// depend on the thread count.
 pub fn run_all(
     spec: &SweepSpec,
     out_dir: &Path,
@@ -72,7 +74,8 @@ pub fn run_all(
 
 /// [`run_all`] for a shard's part: the critical searches at positions `j` of `critical.mu`
 /// and the orbit panels at positions `i` for which `owns` is true, and the probability
-/// ensemble when `owns(0)` (it is one job).
+/// ensemble when `owns(0)` (it is one job). When more than one fails, the error reported is
+/// the critical search's, then the orbits', then the ensemble's.
 pub fn run_all_owned(
     spec: &SweepSpec,
     out_dir: &Path,
@@ -81,26 +84,39 @@ pub fn run_all_owned(
     owns: impl Fn(usize) -> bool + Sync,
 ) -> Result<ExtrasWritten, ExtrasError> {
     let work = || -> Result<_, ExtrasError> {
-        Ok(ExtrasWritten {
-            critical: run_critical_owned(spec, out_dir, &owns)?,
-            orbits: record_orbits_owned(spec, out_dir, &owns)?,
-            probability: if owns(0) {
-                run_probability(spec, out_dir, threads, progress)?
-            } else {
-                None
+        let ((critical, orbits), probability) = rayon::join(
+            || {
+                rayon::join(
+                    || run_critical_owned(spec, out_dir, &owns),
+                    || record_orbits_owned(spec, out_dir, &owns),
+                )
             },
+            || {
+                if owns(0) {
+                    run_probability_here(spec, out_dir, progress)
+                } else {
+                    Ok(None)
+                }
+            },
+        );
+        Ok(ExtrasWritten {
+            critical: critical?,
+            orbits: orbits?,
+            probability: probability?,
         })
     };
-    match threads {
-        Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
-            Ok(pool) => pool.install(work),
-            Err(_) => work(),
-        },
-        None => work(),
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        builder = builder.num_threads(n);
+    }
+    match builder.build() {
+        Ok(pool) => pool.install(work),
+        Err(_) => work(),
     }
 }
 
-/// Runs the spec's probability ensemble, if any, into `out_dir/probability/`.
+/// Runs the spec's probability ensemble, if any, into `out_dir/probability/` on `threads`
+/// worker threads (`None`: rayon's default).
 pub fn run_probability(
     spec: &SweepSpec,
     out_dir: &Path,
@@ -112,6 +128,20 @@ pub fn run_probability(
     };
     let dir = out_dir.join(PROBABILITY_DIR);
     crate::ensemble::run_ensemble(&e, &dir, threads, progress).map_err(ExtrasError::from_sweep)?;
+    Ok(Some(dir))
+}
+
+/// [`run_probability`] on the current rayon pool.
+fn run_probability_here(
+    spec: &SweepSpec,
+    out_dir: &Path,
+    progress: bool,
+) -> Result<Option<PathBuf>, ExtrasError> {
+    let Some(e) = spec.probability_spec() else {
+        return Ok(None);
+    };
+    let dir = out_dir.join(PROBABILITY_DIR);
+    crate::ensemble::run_ensemble_here(&e, &dir, progress).map_err(ExtrasError::from_sweep)?;
     Ok(Some(dir))
 }
 

@@ -12,7 +12,7 @@
 //! Every name in [`OWNED`] is whirlmap's. A new run into a folder that holds any of them is
 //! refused (exit 2) unless it is told `--resume` (the same spec and build: the records are
 //! kept, every derived file is removed and made again) or `--overwrite` (the old files are
-//! moved into [`PREVIOUS_DIR`] and deleted once the new run's first chunk of records is on
+//! moved into [`PREVIOUS_DIR`] and deleted once the new run's first records are synced to
 //! disk, so a rerun killed early loses nothing). Other files are left alone and never read.
 //!
 //! ## The manifest's file list
@@ -40,8 +40,8 @@ use whirlmap_core::scene::fnv1a64;
 /// The lock file of a results folder (see the module docs).
 pub const LOCK_FILE: &str = ".whirlmap.lock";
 
-/// Where `--overwrite` moves the previous run's files until the new run's first chunk of
-/// records is written.
+/// Where `--overwrite` moves the previous run's files until the new run's first records are
+/// written and synced.
 pub const PREVIOUS_DIR: &str = "previous-run";
 
 /// The names whirlmap writes into a results folder (files and folders).
@@ -310,7 +310,7 @@ pub struct RunFolder {
     _lock: FolderLock,
     /// Relative path (`/`-separated) -> entry.
     pub(crate) files: BTreeMap<String, FileEntry>,
-    /// The previous run's files (`--overwrite`), deleted after the first chunk.
+    /// The previous run's files (`--overwrite`), deleted once the first records are synced.
     previous: Option<PathBuf>,
 }
 
@@ -395,7 +395,7 @@ impl RunFolder {
     }
 
     /// Moves the owned files in `present` into [`PREVIOUS_DIR`]. When an earlier overwrite
-    /// was killed before its first chunk (the folder's own points hold no complete record),
+    /// was killed before its first records (the folder's own points hold no complete record),
     /// the files moved aside then are the ones worth keeping: they stay, and the current
     /// ones are removed.
     fn move_aside(&mut self, present: &[&str]) -> Result<(), SweepError> {

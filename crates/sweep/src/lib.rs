@@ -8,6 +8,8 @@
 //!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
 //! - [`folder`]: a results folder's lock, its manifest's file list and the checks of a
 //!   reader; [`build_info`]: the build (version and commit) every manifest records.
+//! - [`ordered`]: work stealing over numbered jobs with an ordered, bounded writer (how a
+//!   sweep's grid runs).
 //! - [`shard`] and [`merge`]: a sweep split over machines and joined again.
 //! - [`compare`]: what changed between two results (nightly jobs).
 //! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
@@ -35,6 +37,7 @@ pub mod fig4;
 pub mod folder;
 pub mod fonts;
 pub mod merge;
+pub mod ordered;
 pub mod overrides;
 pub mod prob_chart;
 pub mod recheck;

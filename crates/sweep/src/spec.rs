@@ -860,7 +860,7 @@ impl SweepSpec {
 
     /// Every grid point, row-major (first axis slowest), each scene validated. This holds
     /// the whole grid in memory: for small grids (an ensemble's cells, tests); a sweep
-    /// builds its points chunk by chunk with [`SweepSpec::grid`].
+    /// builds each point from its index when it runs it, with [`SweepSpec::grid`].
     pub fn points(&self) -> Result<Vec<Point>, SpecError> {
         let grid = self.grid()?;
         (0..grid.len()).map(|i| grid.point(i)).collect()
