@@ -170,6 +170,48 @@ fn points_are_byte_identical_for_any_thread_count() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Runs `whirlmap sweep spec --out out` on `threads` threads and kills it as soon as two
+/// records are in `points.jsonl` (and before `grid_size` are); returns that file's path.
+fn kill_after_two_lines(spec: &Path, out: &Path, threads: &str, grid_size: usize) -> PathBuf {
+    let mut child = Command::new(BIN)
+        .args([
+            "sweep",
+            s(spec),
+            "--out",
+            s(out),
+            "--threads",
+            threads,
+            "--no-progress",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let points = out.join("points.jsonl");
+    let start = Instant::now();
+    loop {
+        let n = std::fs::read_to_string(&points)
+            .map(|t| t.matches('\n').count())
+            .unwrap_or(0);
+        if n >= 2 {
+            assert!(
+                n < grid_size,
+                "the sweep finished before it could be killed"
+            );
+            child.kill().unwrap();
+            break;
+        }
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the sweep ended before writing 2 lines"
+        );
+        assert!(start.elapsed() < Duration::from_secs(60), "no progress");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.wait().unwrap();
+    points
+}
+
 const RESUME_SPEC: &str = r#"{
   "name": "resume",
   "scene": {"solver": {"rtol": 1e-9}},
@@ -185,39 +227,7 @@ fn a_killed_sweep_resumes_to_the_uninterrupted_file() {
     let (full, killed) = (dir.join("full"), dir.join("killed"));
 
     // Interrupted run: one thread; kill once some but not all lines are in.
-    let mut child = Command::new(BIN)
-        .args([
-            "sweep",
-            s(&spec),
-            "--out",
-            s(&killed),
-            "--threads",
-            "1",
-            "--no-progress",
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let points = killed.join("points.jsonl");
-    let start = Instant::now();
-    loop {
-        let n = std::fs::read_to_string(&points)
-            .map(|t| t.matches('\n').count())
-            .unwrap_or(0);
-        if n >= 2 {
-            assert!(n < 16, "the sweep finished before it could be killed");
-            child.kill().unwrap();
-            break;
-        }
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "the sweep ended before writing 2 lines"
-        );
-        assert!(start.elapsed() < Duration::from_secs(60), "no progress");
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    child.wait().unwrap();
+    let points = kill_after_two_lines(&spec, &killed, "1", 16);
     let before = std::fs::read_to_string(&points).unwrap();
     let complete = before.matches('\n').count();
     assert!(
@@ -384,39 +394,7 @@ fn a_killed_run_on_three_threads_holds_a_grid_prefix_and_resumes_to_the_same_byt
     let spec = dir.join("uneven.json");
     std::fs::write(&spec, UNEVEN_SPEC).unwrap();
     let (full, killed) = (dir.join("full"), dir.join("killed"));
-    let mut child = Command::new(BIN)
-        .args([
-            "sweep",
-            s(&spec),
-            "--out",
-            s(&killed),
-            "--threads",
-            "3",
-            "--no-progress",
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let points = killed.join("points.jsonl");
-    let start = Instant::now();
-    loop {
-        let n = std::fs::read_to_string(&points)
-            .map(|t| t.matches('\n').count())
-            .unwrap_or(0);
-        if n >= 2 {
-            assert!(n < 24, "the sweep finished before it could be killed");
-            child.kill().unwrap();
-            break;
-        }
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "the sweep ended before writing 2 lines"
-        );
-        assert!(start.elapsed() < Duration::from_secs(60), "no progress");
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    child.wait().unwrap();
+    let points = kill_after_two_lines(&spec, &killed, "3", 24);
     // Whatever finished out of order, the file holds the first points of the grid, in order,
     // each once.
     let got = indices(&points);
