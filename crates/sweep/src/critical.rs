@@ -936,24 +936,20 @@ mod tests {
     #[test]
     fn real_drops_are_deterministic_whatever_the_thread_count() {
         let run = |threads: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
+            crate::pool::pool(Some(threads)).unwrap().install(|| {
+                critical_rows(
+                    &Scene::paper(),
+                    &[0.4, 0.3],
+                    &CriticalOptions {
+                        from_rpm: 4000.0,
+                        to_rpm: 5000.0,
+                        resolution_rpm: 500.0,
+                        tol_rpm: 250.0,
+                        duration_s: 0.2,
+                    },
+                )
                 .unwrap()
-                .install(|| {
-                    critical_rows(
-                        &Scene::paper(),
-                        &[0.4, 0.3],
-                        &CriticalOptions {
-                            from_rpm: 4000.0,
-                            to_rpm: 5000.0,
-                            resolution_rpm: 500.0,
-                            tol_rpm: 250.0,
-                            duration_s: 0.2,
-                        },
-                    )
-                    .unwrap()
-                })
+            })
         };
         let one = run(1);
         let three = run(3);

@@ -105,11 +105,7 @@ pub fn run_all_owned(
             probability: probability?,
         })
     };
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        builder = builder.num_threads(n);
-    }
-    match builder.build() {
+    match crate::pool::pool(threads) {
         Ok(pool) => pool.install(work),
         Err(_) => work(),
     }

@@ -39,6 +39,7 @@ pub mod fonts;
 pub mod merge;
 pub mod ordered;
 pub mod overrides;
+pub mod pool;
 pub mod prob_chart;
 pub mod recheck;
 pub mod record;

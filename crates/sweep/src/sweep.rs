@@ -897,13 +897,8 @@ pub fn run_grid(
     run: &mut SweepRun,
 ) -> Result<(), SweepError> {
     let grid: Grid = spec.grid()?;
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = opts.threads {
-        builder = builder.num_threads(n);
-    }
-    let pool = builder
-        .build()
-        .map_err(|e| SweepError::ThreadPool(e.to_string()))?;
+    let pool =
+        crate::pool::pool(opts.threads).map_err(|e| SweepError::ThreadPool(e.to_string()))?;
     let threads = pool.current_num_threads();
     run.record.meta.threads = threads;
     let out = opts.out_dir.clone();
