@@ -44,6 +44,7 @@ pub mod prob_chart;
 pub mod recheck;
 pub mod record;
 pub mod render;
+pub mod run;
 pub mod shard;
 pub mod spec;
 pub mod sweep;
