@@ -30,9 +30,7 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create {}", a.out.display()))
         .map_err(Failure::Output)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(a.threads as usize)
-        .build()
+    let pool = whirlmap_sweep::pool::pool(Some(a.threads as usize))
         .map_err(|e| Failure::Input(e.into()))?;
     let jobs = spec.cases.len()
         * (2 + 3

@@ -13,13 +13,14 @@
 
 use crate::classify::OrbitClass;
 use crate::overrides::{self, OverrideError};
+use crate::run::run_drop;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 use std::path::Path;
 use std::time::Instant;
 use thiserror::Error;
-use whirlmap_core::{simulate, DropOptions, Fidelity, Method, Scene};
+use whirlmap_core::{DropOptions, Fidelity, Method, Scene};
 
 /// Why an accuracy spec is unusable.
 #[derive(Debug, Error)]
@@ -274,7 +275,8 @@ pub struct Measured {
     pub wall_ms: f64,
 }
 
-/// Runs one drop and measures it; `Err` carries the solver error kind and message.
+/// Runs one drop and measures it; `Err` carries the failure's kind and message (a solver
+/// error, or a panic inside the solver, kind `panic`).
 pub fn measure(scene: &Scene, duration_s: f64, record_orbit: bool) -> Result<Measured, String> {
     let opts = DropOptions {
         duration_s,
@@ -282,7 +284,7 @@ pub fn measure(scene: &Scene, duration_s: f64, record_orbit: bool) -> Result<Mea
         ..Default::default()
     };
     let t = Instant::now();
-    let r = simulate(scene, &opts).map_err(|e| format!("{}: {e}", e.kind()))?;
+    let r = run_drop(scene, &opts).map_err(|e| format!("{}: {e}", e.kind()))?;
     let wall_ms = t.elapsed().as_secs_f64() * 1e3;
     let f = &r.features;
     Ok(Measured {

@@ -511,13 +511,7 @@ pub fn run_adaptive(
         allowed: "an adaptive section".into(),
     })?;
     check_output_dir(out_dir)?;
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        builder = builder.num_threads(n);
-    }
-    let pool = builder
-        .build()
-        .map_err(|e| SweepError::ThreadPool(e.to_string()))?;
+    let pool = crate::pool::pool(threads).map_err(|e| SweepError::ThreadPool(e.to_string()))?;
     let (speeds, mus) = fine_axes(spec);
     let shape = (speeds.len(), mus.len());
     let speed_first = spec.axes.0[0].name == "speed_rpm";

@@ -28,10 +28,11 @@
 
 use crate::classify::OrbitClass;
 use crate::recheck::Recheck;
+use crate::run::{run_drop, DropFailure};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use whirlmap_core::scene::num;
-use whirlmap_core::{simulate, DropOptions, InvalidParameter, Scene, MODEL_VERSION};
+use whirlmap_core::{DropOptions, InvalidParameter, Scene, MODEL_VERSION};
 
 /// Default lattice step of the scan (r/min).
 pub const DEFAULT_RESOLUTION_RPM: f64 = 250.0;
@@ -675,17 +676,10 @@ pub fn search<F: Fn(f64) -> Outcome + Sync>(
 pub fn drop_outcome(scene: &Scene, speed_rpm: f64, opts: &DropOptions) -> Outcome {
     let mut s = scene.clone();
     s.speed_rpm = speed_rpm;
-    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| simulate(&s, opts))) {
-        Ok(Ok(r)) => Outcome::Class(r.verdict.class),
-        Ok(Err(e)) => Outcome::Failed(format!("{}: {e}", e.kind())),
-        Err(payload) => Outcome::Failed(format!(
-            "panic: {}",
-            payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_default()
-        )),
+    match run_drop(&s, opts) {
+        Ok(r) => Outcome::Class(r.verdict.class),
+        Err(DropFailure::Solve(e)) => Outcome::Failed(format!("{}: {e}", e.kind())),
+        Err(DropFailure::Panic(m)) => Outcome::Failed(format!("panic: {m}")),
     }
 }
 
@@ -936,24 +930,20 @@ mod tests {
     #[test]
     fn real_drops_are_deterministic_whatever_the_thread_count() {
         let run = |threads: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
+            crate::pool::pool(Some(threads)).unwrap().install(|| {
+                critical_rows(
+                    &Scene::paper(),
+                    &[0.4, 0.3],
+                    &CriticalOptions {
+                        from_rpm: 4000.0,
+                        to_rpm: 5000.0,
+                        resolution_rpm: 500.0,
+                        tol_rpm: 250.0,
+                        duration_s: 0.2,
+                    },
+                )
                 .unwrap()
-                .install(|| {
-                    critical_rows(
-                        &Scene::paper(),
-                        &[0.4, 0.3],
-                        &CriticalOptions {
-                            from_rpm: 4000.0,
-                            to_rpm: 5000.0,
-                            resolution_rpm: 500.0,
-                            tol_rpm: 250.0,
-                            duration_s: 0.2,
-                        },
-                    )
-                    .unwrap()
-                })
+            })
         };
         let one = run(1);
         let three = run(3);

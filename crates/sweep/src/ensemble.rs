@@ -955,13 +955,7 @@ pub fn run_ensemble(
     threads: Option<usize>,
     show_progress: bool,
 ) -> Result<EnsembleOutcome, SweepError> {
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        builder = builder.num_threads(n);
-    }
-    let pool = builder
-        .build()
-        .map_err(|e| SweepError::ThreadPool(e.to_string()))?;
+    let pool = crate::pool::pool(threads).map_err(|e| SweepError::ThreadPool(e.to_string()))?;
     pool.install(|| run_ensemble_here(spec, out_dir, show_progress))
 }
 

@@ -2,12 +2,13 @@
 //! and the orbits of the Fig. 3 chart (`orbits/*.json`), in the forms [`crate::charts`] reads.
 
 use crate::critical::{critical_rows, csv_text, CriticalRow};
+use crate::run::run_drop;
 use crate::spec::SweepSpec;
 use rayon::prelude::*;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
-use whirlmap_core::{simulate, DropOptions};
+use whirlmap_core::DropOptions;
 
 /// Why an extra output could not be made.
 #[derive(Debug, Error)]
@@ -105,11 +106,7 @@ pub fn run_all_owned(
             probability: probability?,
         })
     };
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        builder = builder.num_threads(n);
-    }
-    match builder.build() {
+    match crate::pool::pool(threads) {
         Ok(pool) => pool.install(work),
         Err(_) => work(),
     }
@@ -223,7 +220,8 @@ pub fn orbit_panels(spec: &SweepSpec) -> Option<(f64, Vec<f64>)> {
 
 /// Records one orbit per panel (in parallel, order kept) and writes
 /// `orbits/NN_speed_mu.json` files `{"speed_rpm", "mu", "class", "orbit"}`; a drop that fails
-/// is skipped with its error in `orbits/NN_speed_mu.error.txt`. Returns the files written.
+/// (a solver error or a panic) is skipped with its error in `orbits/NN_speed_mu.error.txt`.
+/// Returns the files written.
 pub fn record_orbits(spec: &SweepSpec, out_dir: &Path) -> Result<Vec<PathBuf>, ExtrasError> {
     record_orbits_owned(spec, out_dir, |_| true)
 }
@@ -255,7 +253,7 @@ pub fn record_orbits_owned(
                 orbit_points: Some(20_000),
                 ..Default::default()
             };
-            (i, mu, simulate(&scene, &opts))
+            (i, mu, run_drop(&scene, &opts))
         })
         .collect();
     let mut written = Vec::new();

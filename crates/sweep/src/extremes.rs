@@ -6,9 +6,10 @@
 //! `cargo run --release --example extremes`, whose results
 //! docs/accuracy.md#stability-at-the-extremes records.
 
+use crate::run::{run_drop, DropFailure};
 use serde::Serialize;
 use std::time::Instant;
-use whirlmap_core::{simulate, DropOptions, DropReport, Scene};
+use whirlmap_core::{DropOptions, DropReport, Scene};
 
 /// One point of the matrix.
 #[derive(Debug, Clone)]
@@ -179,7 +180,7 @@ pub fn run_point(p: &ExtremePoint) -> ExtremeOutcome {
         ..Default::default()
     };
     let t = Instant::now();
-    let out = std::panic::catch_unwind(|| simulate(&p.scene, &opts));
+    let out = run_drop(&p.scene, &opts);
     let wall_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut o = ExtremeOutcome {
         name: p.name.clone(),
@@ -193,19 +194,19 @@ pub fn run_point(p: &ExtremePoint) -> ExtremeOutcome {
         problems: Vec::new(),
     };
     let r = match out {
-        Err(_) => {
+        Err(DropFailure::Panic(m)) => {
             o.status = "panic".into();
-            o.problems.push("simulate panicked".into());
+            o.problems.push(format!("simulate panicked: {m}"));
             return o;
         }
-        Ok(Err(e)) => {
+        Err(DropFailure::Solve(e)) => {
             o.status = e.kind().into();
             if matches!(e, whirlmap_core::SolveError::Invalid(_)) {
                 o.problems.push(format!("a valid scene was rejected: {e}"));
             }
             return o;
         }
-        Ok(Ok(r)) => r,
+        Ok(r) => r,
     };
     o.status = "ok".into();
     o.end_time_s = Some(r.end_time_s);

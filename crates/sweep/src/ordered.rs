@@ -241,10 +241,7 @@ mod tests {
     use std::sync::Arc;
 
     fn pool(threads: usize) -> rayon::ThreadPool {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
+        crate::pool::pool(Some(threads)).unwrap()
     }
 
     /// Collects what it is given, checking order; fails at position `fail_at`.

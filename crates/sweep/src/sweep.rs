@@ -40,6 +40,7 @@
 use crate::folder::{self, FileEntry, Mode, RunFolder, RunIdentity};
 use crate::ordered::{run_ordered, OrderedSink};
 use crate::record::DropRecord;
+use crate::run::{catch_drop, DropFailure};
 use crate::spec::{Grid, Point, SpecError, SweepSpec};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::ser::{SerializeMap, Serializer};
@@ -191,33 +192,17 @@ pub fn run_case(point: &Point, duration_s: f64) -> PointRecord {
         duration_s,
         ..Default::default()
     };
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        simulate(&point.scene, &opts).map(|r| DropRecord::from_report(&r))
-    }));
+    let result = catch_drop(|| simulate(&point.scene, &opts).map(|r| DropRecord::from_report(&r)));
     let (status, record, error) = match result {
-        Ok(Ok(rec)) => (Status::Ok, Some(rec), None),
-        Ok(Err(e)) => (
-            Status::Failed,
-            None,
-            Some(PointError {
-                kind: e.kind().to_string(),
-                message: e.to_string(),
-            }),
-        ),
-        Err(payload) => {
-            let message = payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "panic".to_string());
-            (
-                Status::Failed,
-                None,
-                Some(PointError {
-                    kind: "panic".into(),
-                    message,
-                }),
-            )
+        Ok(rec) => (Status::Ok, Some(rec), None),
+        Err(e) => {
+            let kind = e.kind().to_string();
+            let message = match e {
+                DropFailure::Solve(e) => e.to_string(),
+                // The bare panic message: the kind already says it was a panic.
+                DropFailure::Panic(m) => m,
+            };
+            (Status::Failed, None, Some(PointError { kind, message }))
         }
     };
     PointRecord {
@@ -897,13 +882,8 @@ pub fn run_grid(
     run: &mut SweepRun,
 ) -> Result<(), SweepError> {
     let grid: Grid = spec.grid()?;
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = opts.threads {
-        builder = builder.num_threads(n);
-    }
-    let pool = builder
-        .build()
-        .map_err(|e| SweepError::ThreadPool(e.to_string()))?;
+    let pool =
+        crate::pool::pool(opts.threads).map_err(|e| SweepError::ThreadPool(e.to_string()))?;
     let threads = pool.current_num_threads();
     run.record.meta.threads = threads;
     let out = opts.out_dir.clone();
