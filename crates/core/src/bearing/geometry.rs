@@ -25,9 +25,12 @@
 //! choices, see [`BearingPair::paper_71908_cd`].
 
 use super::hertz::{series_stiffness_n_per_m1_5, PointContact, Race};
-use super::load::RADIAL_INTEGRAL_ZERO_CLEARANCE;
 use crate::error::InvalidParameter;
 use serde::{Deserialize, Serialize};
+
+/// Harris's radial integral for zero clearance, `J_r(0.5) = (1/2π) ∫_{-π/2}^{π/2} cos^2.5 ψ
+/// dψ = Γ(7/4) / (2 √π Γ(9/4))` (Harris & Kotzalas ch. 7, tabulated there as 0.2288).
+pub const RADIAL_INTEGRAL_ZERO_CLEARANCE: f64 = 0.228_827_929_050_544;
 
 /// ISO 76's limiting contact pressure for ball bearings other than self-aligning (Pa): the
 /// static load rating is the load that produces it at the most heavily loaded contact.

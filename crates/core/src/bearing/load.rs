@@ -37,12 +37,9 @@
 //! `Q_max = K_n (r cos α)^1.5 = F_row / (Z J_r cos α) = 4.370 F_row / (Z cos α)`.
 
 use super::geometry::BearingPair;
+pub use super::geometry::RADIAL_INTEGRAL_ZERO_CLEARANCE;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
-
-/// Harris's radial integral for zero clearance, `J_r(0.5) = (1/2π) ∫_{-π/2}^{π/2} cos^2.5 ψ
-/// dψ = Γ(7/4) / (2 √π Γ(9/4))` (Harris & Kotzalas ch. 7, tabulated there as 0.2288).
-pub const RADIAL_INTEGRAL_ZERO_CLEARANCE: f64 = 0.228_827_929_050_544;
 
 /// Stribeck's factor for point contact and zero clearance, `1 / J_r(0.5) = 4.370`:
 /// `Q_max = 4.37 F_r / (Z cos α)` (Harris & Kotzalas ch. 7; Stribeck 1901). The design rule
