@@ -1011,7 +1011,7 @@ mod tests {
     fn torn_last_line_is_dropped_and_truncated() {
         let dir = std::env::temp_dir().join(format!("whirlmap-sweep-unit-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let p = dir.join("points.jsonl");
+        let p = dir.join(POINTS_FILE);
         std::fs::write(
             &p,
             "{\"key\":\"a\",\"status\":\"ok\"}\n{\"key\":\"b\",\"status\":\"failed\"}\n{\"key\":\"b\",\"status\":\"ok\"}\n{\"key\":\"c\",\"sta",
