@@ -57,7 +57,8 @@ pub fn run(a: &RenderArgs) -> Result<(), RenderFailure> {
         }
     })?;
     if checked.listed {
-        folder::relist_tree(&a.dir, "charts").map_err(|e| RenderFailure::Output(e.into()))?;
+        folder::relist_tree(&a.dir, whirlmap_sweep::results::files::CHARTS_DIR)
+            .map_err(|e| RenderFailure::Output(e.into()))?;
     }
     for p in &written {
         outln!("{}", p.display());

@@ -100,12 +100,12 @@ pub fn run(a: &SweepArgs) -> u8 {
             if let Some(p) = &x.critical {
                 outln!("  critical speeds  {}", p.display());
                 listed.push(p.clone());
-                listed.push(dir.join(whirlmap_sweep::extras::CRITICAL_CSV_FILE));
+                listed.push(dir.join(whirlmap_sweep::results::files::CRITICAL_CSV_FILE));
             }
             if !x.orbits.is_empty() {
                 outln!("  orbits           {} drops recorded", x.orbits.len());
             }
-            listed.push(dir.join("orbits"));
+            listed.push(dir.join(whirlmap_sweep::results::files::ORBITS_DIR));
             if let Some(p) = &x.probability {
                 outln!("  probability      {}", p.display());
                 listed.push(p.clone());
@@ -130,7 +130,7 @@ pub fn run(a: &SweepArgs) -> u8 {
                 return 4;
             }
         }
-        if let Err(e) = run.record(&dir.join("charts")) {
+        if let Err(e) = run.record(&dir.join(whirlmap_sweep::results::files::CHARTS_DIR)) {
             errln!("error: {e}");
             return e.exit_code();
         }

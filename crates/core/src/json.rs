@@ -69,6 +69,13 @@ pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, serde_
     Ok(parsed)
 }
 
+/// Reads a number that may have been written as `null`: serde_json writes a NaN (or an
+/// infinity) as `null`, so a field that may hold NaN reads `null` back as NaN.
+pub fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    use serde::Deserialize;
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -69,12 +69,15 @@ pub struct WindowStats {
     pub angle_time_s: f64,
     /// Circular (time-weighted) mean of the contact angle, in (-pi, pi] (rad). NaN without
     /// angle samples.
+    #[serde(deserialize_with = "crate::json::f64_or_nan")]
     pub angle_mean_rad: f64,
     /// Circular standard deviation `sqrt(-2 ln R)` of the contact angle, R the mean
     /// resultant length (rad). NaN without angle samples.
+    #[serde(deserialize_with = "crate::json::f64_or_nan")]
     pub angle_spread_rad: f64,
     /// Range (largest minus smallest) of the unwrapped contact angle (rad). NaN without
     /// angle samples.
+    #[serde(deserialize_with = "crate::json::f64_or_nan")]
     pub angle_range_rad: f64,
     /// Net turns of the contact point, signed relative to the spin (negative: against it).
     pub net_turns: f64,

@@ -40,8 +40,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Output file of `whirlmap adaptive`.
-pub const ADAPTIVE_FILE: &str = "adaptive.json";
+pub use whirlmap_results::files::ADAPTIVE_FILE;
 
 fn default_bounds() -> [f64; 2] {
     [0.1, 0.9]

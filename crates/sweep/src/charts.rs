@@ -11,7 +11,6 @@
 //! Whirl cells are left out of the force and heat colour scales (as in the paper's Fig. 5) but
 //! hatched so their place stays visible; failed points are marked with a cross.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use plotters::coord::Shift;
@@ -19,9 +18,12 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use serde::Deserialize;
 use serde_json::Value;
-use whirlmap_core::orbit::Orbit;
+use whirlmap_results::critical::read_critical;
+use whirlmap_results::files::{CHARTS_DIR, CONTOURS_FILE, PROBABILITY_DIR};
+use whirlmap_results::orbit::read_orbits;
+use whirlmap_results::point::{MU_KEYS, SPEED_KEYS};
+use whirlmap_results::read::{read_json_optional, ReadError};
 
 use crate::classify::OrbitClass;
 use crate::critical::CriticalRow;
@@ -36,11 +38,6 @@ use crate::render::{
 
 /// Size (width, height) in pixels of the grid charts and Fig. 4.
 pub const CHART_SIZE: (u32, u32) = (1000, 700);
-
-/// The input names of the speed axis.
-const SPEED_KEYS: [&str; 1] = ["speed_rpm"];
-/// The input names of the friction axis (`mu` first).
-const MU_KEYS: [&str; 2] = ["mu", "mu_dynamic"];
 
 const SPEED_DESC: &str = "release speed (r/min)";
 pub(crate) const MU_DESC: &str = "friction coefficient µ (-)";
@@ -95,154 +92,35 @@ impl ChartError {
 // ---------------------------------------------------------------------------------------------
 // Loading.
 
-/// Whether a grid point ran.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PointStatus {
-    /// The drop finished and has a record.
-    Ok,
-    /// The drop failed (or the status is unknown).
-    Failed,
-}
+pub use whirlmap_results::orbit::OrbitFile;
+pub use whirlmap_results::point::{PointRow, PointStatus};
 
-/// One line of `points.jsonl`, reduced to what the charts use.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PointRow {
-    /// The point's stable key.
-    pub key: String,
-    /// The point's index in the sweep, if given.
-    pub index: Option<u64>,
-    /// The sweep inputs (`speed_rpm`, `mu`, ...), as written.
-    pub inputs: BTreeMap<String, Value>,
-    /// Whether the drop ran.
-    pub status: PointStatus,
-    /// Orbit class (ok points whose record names one).
-    pub class: Option<OrbitClass>,
-    /// Maximum contact force (N), if finite.
-    pub max_contact_force_n: Option<f64>,
-    /// Peak heat power (W), if finite.
-    pub peak_heat_power_w: Option<f64>,
-    /// Hottest peak node temperature (K), for records made with the thermal model.
-    pub peak_temperature_k: Option<f64>,
-    /// The error of a failed point, as text.
-    pub error: Option<String>,
-    /// Simulated time asked for (s), when the record says.
-    pub duration_s: Option<f64>,
-}
-
-impl PointRow {
-    /// The numeric input under the first of `keys` present.
-    fn input(&self, keys: &[&str]) -> Option<f64> {
-        keys.iter()
-            .find_map(|k| self.inputs.get(*k))
-            .and_then(Value::as_f64)
-    }
-    /// Release speed (r/min), if an input.
-    pub fn speed_rpm(&self) -> Option<f64> {
-        self.input(&SPEED_KEYS)
-    }
-    /// Friction coefficient, if an input.
-    pub fn mu(&self) -> Option<f64> {
-        self.input(&MU_KEYS)
-    }
-}
-
-#[derive(Deserialize)]
-struct RawRow {
-    #[serde(default)]
-    key: Option<String>,
-    #[serde(default)]
-    index: Option<u64>,
-    #[serde(default)]
-    inputs: BTreeMap<String, Value>,
-    #[serde(default)]
-    status: Option<String>,
-    #[serde(default)]
-    record: Option<Value>,
-    #[serde(default)]
-    error: Option<Value>,
-    #[serde(default)]
-    duration_s: Option<f64>,
-}
-
-fn finite(v: Option<&Value>) -> Option<f64> {
-    v.and_then(Value::as_f64).filter(|x| x.is_finite())
-}
-
-impl From<RawRow> for PointRow {
-    fn from(r: RawRow) -> Self {
-        let ok = r.status.as_deref() == Some("ok") && r.record.is_some();
-        let rec = r.record.as_ref().filter(|_| ok);
-        let error = r.error.map(|e| match e {
-            Value::String(s) => s,
-            other => other
-                .get("message")
-                .and_then(Value::as_str)
-                .map(str::to_string)
-                .unwrap_or_else(|| other.to_string()),
-        });
-        PointRow {
-            key: r.key.unwrap_or_default(),
-            index: r.index,
-            inputs: r.inputs,
-            status: if ok {
-                PointStatus::Ok
-            } else {
-                PointStatus::Failed
+impl From<ReadError> for ChartError {
+    fn from(e: ReadError) -> Self {
+        match e {
+            ReadError::NotFound { path } => ChartError::NoPoints { path },
+            ReadError::Io { path, source } => ChartError::Read {
+                path,
+                cause: source,
             },
-            class: rec
-                .and_then(|v| v.get("class"))
-                .and_then(|c| serde_json::from_value(c.clone()).ok()),
-            max_contact_force_n: finite(rec.and_then(|v| v.get("max_contact_force_n"))),
-            peak_heat_power_w: finite(rec.and_then(|v| v.get("peak_heat_power_w"))),
-            peak_temperature_k: rec
-                .and_then(|v| v.get("temperatures_k"))
-                .and_then(Value::as_object)
-                .and_then(|nodes| {
-                    nodes
-                        .values()
-                        .filter_map(|n| finite(n.get("peak")))
-                        .reduce(f64::max)
-                }),
-            error,
-            duration_s: r.duration_s,
+            ReadError::Parse {
+                path,
+                line,
+                message,
+            } => ChartError::Parse {
+                path,
+                line,
+                message,
+            },
         }
     }
 }
 
-/// Reads `dir/points.jsonl`. Blank lines are ignored and an unparseable last line after at
-/// least one record (a write torn by a crash) is skipped; an unparseable line elsewhere, or a
-/// file whose only line is not a record, is an error.
+/// Reads `dir/points.jsonl` ([`whirlmap_results::point::load_points`]). Blank lines are
+/// ignored and a torn last line (no newline, does not parse) after at least one record is
+/// skipped; an unparseable line elsewhere, or a file whose only line is torn, is an error.
 pub fn load_points(dir: &Path) -> Result<Vec<PointRow>, ChartError> {
-    let path = dir.join("points.jsonl");
-    let bytes = match std::fs::read(&path) {
-        Ok(b) => b,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(ChartError::NoPoints { path })
-        }
-        Err(cause) => return Err(ChartError::Read { path, cause }),
-    };
-    let text = String::from_utf8_lossy(&bytes);
-    let lines: Vec<(usize, &str)> = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty())
-        .collect();
-    let mut rows = Vec::with_capacity(lines.len());
-    for (k, (n, line)) in lines.iter().enumerate() {
-        match serde_json::from_str::<RawRow>(line) {
-            Ok(raw) => rows.push(PointRow::from(raw)),
-            // A torn last line after real records.
-            Err(_) if k + 1 == lines.len() && k > 0 => {}
-            Err(e) => {
-                return Err(ChartError::Parse {
-                    path,
-                    line: n + 1,
-                    message: format!("not a record of a grid point: {e}"),
-                })
-            }
-        }
-    }
-    Ok(rows)
+    Ok(whirlmap_results::point::load_points(dir)?)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1051,101 +929,25 @@ fn draw_colour_bar<DB: DrawingBackend>(
 // ---------------------------------------------------------------------------------------------
 // Fig. 4's inputs (the figure is in `crate::fig4`).
 
-/// Reads and parses the JSON file `path`, or `None` if it does not exist.
-fn read_optional_json<T: serde::de::DeserializeOwned>(
-    path: PathBuf,
-) -> Result<Option<T>, ChartError> {
-    let text = match std::fs::read_to_string(&path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(cause) => return Err(ChartError::Read { path, cause }),
-    };
-    serde_json::from_str(&text)
-        .map(Some)
-        .map_err(|e| ChartError::Parse {
-            path,
-            line: e.line(),
-            message: e.to_string(),
-        })
-}
-
 /// Reads `dir/critical.json` (a list of [`CriticalRow`]), or `None` if it does not exist.
 pub fn load_critical(dir: &Path) -> Result<Option<Vec<CriticalRow>>, ChartError> {
-    read_optional_json(dir.join(crate::extras::CRITICAL_FILE))
+    Ok(read_critical(dir)?)
 }
 
 /// Reads the probability ensemble's `contours.json` of a sweep (`dir/probability/`), or
 /// `None` if the sweep ran none.
 pub fn load_probability(dir: &Path) -> Result<Option<ContoursFile>, ChartError> {
-    read_optional_json(
-        dir.join(crate::extras::PROBABILITY_DIR)
-            .join(crate::ensemble::CONTOURS_FILE),
-    )
+    Ok(read_json_optional(
+        &dir.join(PROBABILITY_DIR).join(CONTOURS_FILE),
+    )?)
 }
 
 // ---------------------------------------------------------------------------------------------
 // Fig. 3: orbit panels.
 
-/// One recorded orbit from `orbits/*.json`.
-#[derive(Debug, Clone, Deserialize)]
-pub struct OrbitFile {
-    /// Release speed (r/min).
-    pub speed_rpm: f64,
-    /// Friction coefficient.
-    pub mu: f64,
-    /// Orbit class (a class name).
-    #[serde(default)]
-    pub class: Value,
-    /// The recorded orbit.
-    pub orbit: Orbit,
-}
-
-impl OrbitFile {
-    fn class_label(&self) -> String {
-        match serde_json::from_value::<OrbitClass>(self.class.clone()) {
-            Ok(c) => c.label().to_string(),
-            Err(_) => match &self.class {
-                Value::String(s) => s.replace('_', " "),
-                Value::Null => "class unknown".to_string(),
-                other => other.to_string(),
-            },
-        }
-    }
-}
-
 /// Reads every `dir/orbits/*.json`, sorted by speed then friction; empty if there are none.
 pub fn load_orbits(dir: &Path) -> Result<Vec<OrbitFile>, ChartError> {
-    let odir = dir.join("orbits");
-    let Ok(read) = std::fs::read_dir(&odir) else {
-        return Ok(Vec::new());
-    };
-    let mut paths: Vec<PathBuf> = read
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("json"))
-        })
-        .collect();
-    paths.sort();
-    let mut out = Vec::new();
-    for path in paths {
-        let text = std::fs::read_to_string(&path).map_err(|cause| ChartError::Read {
-            path: path.clone(),
-            cause,
-        })?;
-        let o: OrbitFile = serde_json::from_str(&text).map_err(|e| ChartError::Parse {
-            path: path.clone(),
-            line: e.line(),
-            message: e.to_string(),
-        })?;
-        out.push(o);
-    }
-    out.sort_by(|a, b| {
-        a.speed_rpm
-            .total_cmp(&b.speed_rpm)
-            .then(a.mu.total_cmp(&b.mu))
-    });
-    Ok(out)
+    Ok(read_orbits(dir)?)
 }
 
 struct OrbitPanels<'a> {
@@ -1271,7 +1073,7 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
     let orbits = load_orbits(dir)?;
     let grid = assemble_grid(&rows);
 
-    let out_dir = dir.join("charts");
+    let out_dir = dir.join(CHARTS_DIR);
     std::fs::create_dir_all(&out_dir).map_err(|cause| ChartError::Write {
         path: out_dir.clone(),
         cause,

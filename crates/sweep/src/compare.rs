@@ -20,15 +20,14 @@
 //! [`compare`] returns the findings; [`write_report`] writes them as Markdown with a class map
 //! of the new run whose changed cells are outlined.
 
-use crate::charts::{
-    assemble_grid, draw_marked_class_map, load_critical, load_points, ChartError, PointRow,
-    PointStatus,
-};
-use crate::critical::CriticalRow;
+use crate::charts::{assemble_grid, draw_marked_class_map, ChartError};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use whirlmap_results::critical::{read_critical, CriticalRow};
+use whirlmap_results::files::MANIFEST_FILE;
+use whirlmap_results::point::{load_points, PointRow, PointStatus};
 
 /// Relative changes above which a point counts as changed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -154,7 +153,7 @@ pub enum CompareError {
 }
 
 fn run_info(dir: &Path) -> RunInfo {
-    let m: Value = std::fs::read_to_string(dir.join("manifest.json"))
+    let m: Value = std::fs::read_to_string(dir.join(MANIFEST_FILE))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok())
         .unwrap_or(Value::Null);
@@ -341,8 +340,8 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
         return Err(CompareError::Refused(refused));
     }
     let spec_differences = specs_differ(baseline, new);
-    let base_rows = load_points(baseline)?;
-    let new_rows = load_points(new)?;
+    let base_rows = load_points(baseline).map_err(ChartError::from)?;
+    let new_rows = load_points(new).map_err(ChartError::from)?;
     let mut base_by: BTreeMap<String, &PointRow> = BTreeMap::new();
     for r in &base_rows {
         base_by.insert(inputs_key(r), r); // a rerun line replaces an earlier one
@@ -428,7 +427,10 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
         why.extend(not_comparable.iter().take(3).cloned());
         return Err(CompareError::Refused(why));
     }
-    let (critical_compared, critical) = match (load_critical(baseline)?, load_critical(new)?) {
+    let (critical_compared, critical) = match (
+        read_critical(baseline).map_err(ChartError::from)?,
+        read_critical(new).map_err(ChartError::from)?,
+    ) {
         (None, None) => (0, Vec::new()),
         (b, n) => {
             // Searches with other drop durations are other experiments.

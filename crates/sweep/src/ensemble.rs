@@ -68,16 +68,9 @@ use std::time::{Duration, Instant};
 use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::Scene;
 
-/// Per-member records.
-pub const MEMBERS_FILE: &str = "members.jsonl";
-/// Per-cell statistics.
-pub const CELLS_FILE: &str = "cells.jsonl";
 /// Per-cell statistics as CSV.
 pub const CELLS_CSV: &str = "cells.csv";
-/// Probability contours.
-pub const CONTOURS_FILE: &str = "contours.json";
-/// Run metadata.
-pub const MANIFEST_FILE: &str = "manifest.json";
+pub use whirlmap_results::files::{CELLS_FILE, CONTOURS_FILE, MANIFEST_FILE, MEMBERS_FILE};
 
 /// SplitMix64 (Steele, Lea, Flood 2014): a 64-bit state advanced by a Weyl sequence and
 /// mixed by a fixed finaliser. Hand-written for stable streams (see the module doc).

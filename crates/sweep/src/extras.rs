@@ -5,10 +5,12 @@ use crate::critical::{critical_rows, csv_text, CriticalRow};
 use crate::run::run_drop;
 use crate::spec::SweepSpec;
 use rayon::prelude::*;
-use serde_json::json;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 use whirlmap_core::DropOptions;
+use whirlmap_results::critical::critical_json;
+use whirlmap_results::files::{orbit_error_file, orbit_file, ORBITS_DIR};
+use whirlmap_results::orbit::OrbitFile;
 
 /// Why an extra output could not be made.
 #[derive(Debug, Error)]
@@ -23,7 +25,7 @@ pub enum ExtrasError {
     },
 }
 
-/// Writes `text` to `path` all or nothing ([`crate::folder::write_atomic`]), creating its
+/// Writes `text` to `path` all or nothing ([`whirlmap_results::write_atomic`]), creating its
 /// folder.
 fn write(path: &Path, text: &str) -> Result<(), ExtrasError> {
     if let Some(dir) = path.parent() {
@@ -32,7 +34,10 @@ fn write(path: &Path, text: &str) -> Result<(), ExtrasError> {
             source,
         })?;
     }
-    crate::folder::write_atomic(path, text.as_bytes()).map_err(ExtrasError::from_sweep)
+    whirlmap_results::write_atomic(path, text.as_bytes()).map_err(|e| ExtrasError::Io {
+        path: e.path,
+        source: e.source,
+    })
 }
 
 impl ExtrasError {
@@ -142,13 +147,7 @@ fn run_probability_here(
     Ok(Some(dir))
 }
 
-/// Folder of the sweep's probability ensemble (its `contours.json` feeds Fig. 4's band).
-pub const PROBABILITY_DIR: &str = "probability";
-
-/// Critical-speed results file (a JSON list of [`CriticalRow`]).
-pub const CRITICAL_FILE: &str = "critical.json";
-/// The same rows as a table (one line per friction coefficient).
-pub const CRITICAL_CSV_FILE: &str = "critical.csv";
+pub use whirlmap_results::files::{CRITICAL_CSV_FILE, CRITICAL_FILE, PROBABILITY_DIR};
 
 /// Runs the spec's `critical` section, if any, and writes `critical.json` (a list of
 /// [`CriticalRow`] in the order of `critical.mu`) and `critical.csv`. Returns the JSON file.
@@ -186,10 +185,7 @@ pub fn write_critical(
     rows: &[CriticalRow],
 ) -> Result<Option<PathBuf>, ExtrasError> {
     let path = out_dir.join(CRITICAL_FILE);
-    write(
-        &path,
-        &serde_json::to_string_pretty(rows).expect("results serialise"),
-    )?;
+    write(&path, &critical_json(rows))?;
     write(&out_dir.join(CRITICAL_CSV_FILE), &csv_text(rows))?;
     Ok(Some(path))
 }
@@ -260,18 +256,20 @@ pub fn record_orbits_owned(
     for (i, mu, run) in runs {
         let stem = format!("{i:02}_{speed:.0}rpm_mu{mu:.3}");
         match run {
-            Ok(r) => {
-                let class = r.verdict.class;
-                let doc = json!({"speed_rpm": speed, "mu": mu, "class": class, "orbit": r.orbit});
-                let path = out_dir.join("orbits").join(format!("{stem}.json"));
-                write(
-                    &path,
-                    &serde_json::to_string(&doc).expect("orbits serialise"),
-                )?;
+            // Drops asked for orbit points always record an orbit.
+            Ok(r) if r.orbit.is_some() => {
+                let orbit = r.orbit.expect("checked above");
+                let doc = OrbitFile::new(speed, mu, r.verdict.class, orbit);
+                let path = out_dir.join(ORBITS_DIR).join(orbit_file(&stem));
+                write(&path, &doc.to_json())?;
                 written.push(path);
             }
+            Ok(_) => {
+                let path = out_dir.join(ORBITS_DIR).join(orbit_error_file(&stem));
+                write(&path, "no orbit was recorded\n")?;
+            }
             Err(e) => {
-                let path = out_dir.join("orbits").join(format!("{stem}.error.txt"));
+                let path = out_dir.join(ORBITS_DIR).join(orbit_error_file(&stem));
                 write(&path, &format!("{e}\n"))?;
             }
         }

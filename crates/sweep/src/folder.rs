@@ -28,7 +28,7 @@
 //! as before with a warning that they cannot be checked.
 
 use crate::spec::SweepSpec;
-use crate::sweep::{io_err, SweepError, MANIFEST_FILE, POINTS_FILE, TIMINGS_FILE};
+use crate::sweep::{io_err, SweepError};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -36,46 +36,42 @@ use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use whirlmap_core::scene::fnv1a64;
+use whirlmap_results::files::{
+    CHARTS_DIR, COMPARE_CLASSES_FILE, COMPARE_REPORT_FILE, CONTOURS_FILE, CRITICAL_CSV_FILE,
+    CRITICAL_FILE, MANIFEST_FILE, ORBITS_DIR, POINTS_FILE, PROBABILITY_DIR, SHARD_FILE,
+    SUMMARY_FILE, TIMINGS_FILE,
+};
 
-/// The lock file of a results folder (see the module docs).
-pub const LOCK_FILE: &str = ".whirlmap.lock";
-
-/// Where `--overwrite` moves the previous run's files until the new run's first records are
-/// written and synced.
-pub const PREVIOUS_DIR: &str = "previous-run";
+pub use whirlmap_results::files::{LOCK_FILE, PREVIOUS_DIR};
 
 /// The names whirlmap writes into a results folder (files and folders).
 pub const OWNED: &[&str] = &[
     POINTS_FILE,
     TIMINGS_FILE,
-    crate::sweep::SUMMARY_FILE,
+    SUMMARY_FILE,
     MANIFEST_FILE,
-    crate::extras::CRITICAL_FILE,
-    crate::extras::CRITICAL_CSV_FILE,
-    "orbits",
-    "charts",
-    crate::extras::PROBABILITY_DIR,
-    crate::shard::SHARD_FILE,
-    "compare.md",
-    "compare-classes.png",
+    CRITICAL_FILE,
+    CRITICAL_CSV_FILE,
+    ORBITS_DIR,
+    CHARTS_DIR,
+    PROBABILITY_DIR,
+    SHARD_FILE,
+    COMPARE_REPORT_FILE,
+    COMPARE_CLASSES_FILE,
     PREVIOUS_DIR,
 ];
 
 /// The derived names a `--resume` removes before it makes them again.
 const DERIVED: &[&str] = &[
-    crate::sweep::SUMMARY_FILE,
-    crate::extras::CRITICAL_FILE,
-    crate::extras::CRITICAL_CSV_FILE,
-    "orbits",
-    "charts",
-    crate::extras::PROBABILITY_DIR,
-    "compare.md",
-    "compare-classes.png",
+    SUMMARY_FILE,
+    CRITICAL_FILE,
+    CRITICAL_CSV_FILE,
+    ORBITS_DIR,
+    CHARTS_DIR,
+    PROBABILITY_DIR,
+    COMPARE_REPORT_FILE,
+    COMPARE_CLASSES_FILE,
 ];
-
-/// The suffix of a file being written ([`write_atomic`]); one left behind by a killed run is
-/// removed by the next run that takes the lock.
-const TMP_SUFFIX: &str = ".whirlmap-tmp";
 
 /// Whether an I/O error is a failure of the storage (disk full, quota, an I/O error: exit 4)
 /// rather than a bad output path (a file in the way, no permission, a read-only file
@@ -179,68 +175,28 @@ pub fn output_error(dir: &Path, source: std::io::Error) -> SweepError {
     }
 }
 
-/// Writes `bytes` to `path` all or nothing: into a temporary file beside it, synced, renamed
-/// over `path`, and the folder synced. On any failure the temporary file is removed, so a
-/// full disk leaves neither a partial file nor the old one damaged.
+pub use whirlmap_results::atomic::{sync_dir, TMP_SUFFIX};
+
+/// [`whirlmap_results::write_atomic`] with the sweep's error: writes `bytes` to `path` all
+/// or nothing.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SweepError> {
-    write_atomic_with(path, |f| f.write_all(bytes))
+    Ok(whirlmap_results::write_atomic(path, bytes)?)
 }
 
-/// [`write_atomic`] with the content written by `fill` (for files written line by line).
+/// [`whirlmap_results::write_atomic_with`] with the sweep's error: the content written by
+/// `fill`, all or nothing.
 pub fn write_atomic_with(
     path: &Path,
     fill: impl FnOnce(&mut std::io::BufWriter<&File>) -> std::io::Result<()>,
 ) -> Result<(), SweepError> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}{TMP_SUFFIX}"));
-    let result = (|| {
-        let file = File::create(&tmp)?;
-        let mut w = std::io::BufWriter::new(&file);
-        fill(&mut w)?;
-        w.flush()?;
-        drop(w);
-        file.sync_all()?;
-        Ok(())
-    })();
-    if let Err(source) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(SweepError::Io {
-            path: path.to_path_buf(),
-            source,
-        });
-    }
-    if let Err(source) = std::fs::rename(&tmp, path) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(SweepError::Io {
-            path: path.to_path_buf(),
-            source,
-        });
-    }
-    sync_dir(path.parent().unwrap_or(Path::new(".")));
-    Ok(())
-}
-
-/// Syncs a folder so a rename in it survives a power loss (best effort: not every file
-/// system can sync a folder).
-pub fn sync_dir(dir: &Path) {
-    let dir = if dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        dir
-    };
-    if let Ok(d) = File::open(dir) {
-        let _ = d.sync_all();
-    }
+    Ok(whirlmap_results::write_atomic_with(path, fill)?)
 }
 
 /// Removes what a killed run may have left: temporary files of [`write_atomic`] and the
 /// probe files of older versions, in `dir` and its owned subfolders.
 fn remove_leftovers(dir: &Path) {
     let mut dirs = vec![dir.to_path_buf()];
-    for sub in ["orbits", "charts", crate::extras::PROBABILITY_DIR] {
+    for sub in [ORBITS_DIR, CHARTS_DIR, PROBABILITY_DIR] {
         dirs.push(dir.join(sub));
     }
     for d in dirs {
@@ -750,18 +706,14 @@ pub fn reader_inputs(dir: &Path) -> Vec<String> {
     let mut v = Vec::new();
     for f in [
         POINTS_FILE.to_string(),
-        crate::extras::CRITICAL_FILE.to_string(),
-        format!(
-            "{}/{}",
-            crate::extras::PROBABILITY_DIR,
-            crate::ensemble::CONTOURS_FILE
-        ),
+        CRITICAL_FILE.to_string(),
+        format!("{}/{}", PROBABILITY_DIR, CONTOURS_FILE),
     ] {
         if dir.join(&f).is_file() {
             v.push(f);
         }
     }
-    if let Ok(entries) = std::fs::read_dir(dir.join("orbits")) {
+    if let Ok(entries) = std::fs::read_dir(dir.join(ORBITS_DIR)) {
         let mut orbits: Vec<String> = entries
             .flatten()
             .map(|e| e.file_name().to_string_lossy().into_owned())

@@ -1,7 +1,9 @@
 //! # whirlmap-sweep: classification, records and charts on top of whirlmap-core
 //!
 //! - [`classify`]: the orbit class as a pure function of a drop's streamed features.
-//! - [`record`]: the JSON record of one drop (the output contract).
+//! - [`record`]: the JSON record of one drop (the output contract), re-exported from
+//!   [`results`] (`whirlmap-results`: the files of a results folder, their names and typed
+//!   rows, JSONL reading, atomic writes).
 //! - [`overrides`]: scene parameters set by name (`--set key=value`, sweep axes).
 //! - [`render`] and [`fonts`]: charts with an embedded font (no system fonts needed).
 //! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
@@ -21,6 +23,8 @@
 #![warn(missing_docs)]
 // `!(x <= bound)` on purpose: a NaN fails the check instead of passing it.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub use whirlmap_results as results;
 
 pub mod accuracy;
 pub mod accuracy_chart;

@@ -21,7 +21,6 @@
 //! unless `overwrite`.
 
 use crate::charts::{render_all, ChartError};
-use crate::critical::CriticalRow;
 use crate::extras::{orbit_panels, write_critical, CRITICAL_FILE, PROBABILITY_DIR};
 use crate::folder::{self, Mode, RunFolder, RunIdentity};
 use crate::shard::{read_shard_manifest, spec_hash, Shard, ShardManifest};
@@ -36,6 +35,10 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 use whirlmap_core::MODEL_VERSION;
+use whirlmap_results::critical::{read_critical, CriticalRow};
+use whirlmap_results::files::{orbit_error_file, orbit_file, CHARTS_DIR, ORBITS_DIR};
+use whirlmap_results::point::PointLine;
+use whirlmap_results::read::complete_len;
 
 /// Missing points listed per shard in an error, at most.
 const MAX_LISTED: usize = 20;
@@ -283,11 +286,11 @@ pub fn merge(
             }
         };
         // A torn last line (no newline) is a record the shard did not finish writing.
-        let complete = text.rfind('\n').map_or(0, |i| i + 1);
+        let complete = complete_len(text.as_bytes());
         for (n, line) in text[..complete].lines().enumerate() {
-            let key = serde_json::from_str::<Value>(line)
+            let key = serde_json::from_str::<PointLine>(line)
                 .ok()
-                .and_then(|v| v.get("key").and_then(Value::as_str).map(str::to_string));
+                .and_then(|p| p.key);
             match key.as_deref().and_then(|k| by_key.get(k)) {
                 Some(&i) => lines[i].push((d, line.to_string())),
                 None => problems.push(format!(
@@ -360,9 +363,7 @@ pub fn merge(
         critical_rows = vec![None; c_mu.len()];
         for s in &shards {
             let path = s.dir.join(CRITICAL_FILE);
-            let rows: Option<Vec<CriticalRow>> = std::fs::read_to_string(&path)
-                .ok()
-                .and_then(|t| serde_json::from_str(&t).ok());
+            let rows: Option<Vec<CriticalRow>> = read_critical(&s.dir).ok().flatten();
             let Some(rows) = rows.filter(|r| r.len() == s.m.critical_mu.len()) else {
                 if !s.m.critical_mu.is_empty() {
                     let mus: Vec<String> =
@@ -428,9 +429,9 @@ pub fn merge(
             for &i in &s.m.orbit_panels {
                 let Some(mu) = mus.get(i) else { continue };
                 let stem = format!("{i:02}_{speed:.0}rpm_mu{mu:.3}");
-                let found = [".json", ".error.txt"]
+                let found = [orbit_file(&stem), orbit_error_file(&stem)]
                     .iter()
-                    .map(|ext| s.dir.join("orbits").join(format!("{stem}{ext}")))
+                    .map(|name| s.dir.join(ORBITS_DIR).join(name))
                     .find(|p| p.is_file());
                 match found {
                     Some(p) => orbit_files.push(p),
@@ -583,7 +584,7 @@ pub fn merge(
         out.record(crate::extras::CRITICAL_CSV_FILE)?;
     }
     for (files, sub) in [
-        (&orbit_files, "orbits"),
+        (&orbit_files, ORBITS_DIR),
         (&probability_files, PROBABILITY_DIR),
     ] {
         if files.is_empty() {
@@ -615,7 +616,7 @@ pub fn merge(
     } else {
         render_all(out_dir)?
     };
-    out.record_tree("charts")?;
+    out.record_tree(CHARTS_DIR)?;
     record.meta.ended_unix_s = merged_end(&shards);
     write_manifest(&out, &record, true)?;
     Ok(MergeOutcome {

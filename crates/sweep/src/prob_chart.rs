@@ -195,7 +195,7 @@ pub fn render_probability(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         line: e.line(),
         message: e.to_string(),
     })?;
-    let out = dir.join("charts");
+    let out = dir.join(whirlmap_results::files::CHARTS_DIR);
     std::fs::create_dir_all(&out).map_err(|cause| ChartError::Write {
         path: out.clone(),
         cause,

@@ -5,22 +5,10 @@
 //! result says whether the tighter model agrees (non-whirl below, whirl above) and is
 //! recorded next to the bracket.
 
-use crate::critical::{drop_outcome, CriticalRow, Outcome};
-use serde::{Deserialize, Serialize};
+use crate::critical::{drop_outcome, CriticalRow};
 use whirlmap_core::{DropOptions, Fidelity, Scene};
 
-/// The bracket cells run again at a tighter preset.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Recheck {
-    /// The preset the cells were re-run at.
-    pub fidelity: Fidelity,
-    /// Lower bracket speed (r/min) and its outcome at that preset.
-    pub lo: (f64, Outcome),
-    /// Upper bracket speed (r/min) and its outcome at that preset.
-    pub hi: (f64, Outcome),
-    /// True when the tighter preset also gives no whirl at `lo` and whirl at `hi`.
-    pub confirmed: bool,
-}
+pub use whirlmap_results::critical::Recheck;
 
 /// Re-runs the onset bracket of `row` (searched on `scene`, whose `mu_dynamic` is set) at
 /// `tighter`; `None` without a bracket.

@@ -26,7 +26,7 @@ use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::MODEL_VERSION;
 
 /// The file a shard writes before it runs: [`ShardManifest`].
-pub const SHARD_FILE: &str = "shard.json";
+pub use whirlmap_results::files::SHARD_FILE;
 
 /// Largest shard count accepted (a sanity bound for user input).
 pub const MAX_SHARDS: usize = 100_000;
@@ -207,7 +207,7 @@ pub fn run_shard(
     if let Some(c) = &x.critical {
         run.record(&c.with_file_name(crate::extras::CRITICAL_CSV_FILE))?;
     }
-    run.record(&opts.out_dir.join("orbits"))?;
+    run.record(&opts.out_dir.join(whirlmap_results::files::ORBITS_DIR))?;
     write(&ShardManifest {
         complete: true,
         ..manifest

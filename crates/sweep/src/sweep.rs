@@ -43,7 +43,6 @@ use crate::record::DropRecord;
 use crate::run::{catch_drop, DropFailure};
 use crate::spec::{Grid, Point, SpecError, SweepSpec};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use serde::ser::{SerializeMap, Serializer};
 use serde::Serialize;
 use serde_json::Value;
 use std::collections::{BTreeMap, HashMap};
@@ -56,15 +55,9 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use thiserror::Error;
 use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::{simulate, DropOptions, Scene, MODEL_VERSION};
+use whirlmap_results::point::PointLine;
 
-/// Records file name.
-pub const POINTS_FILE: &str = "points.jsonl";
-/// Per-point wall times.
-pub const TIMINGS_FILE: &str = "timings.jsonl";
-/// One row per point.
-pub const SUMMARY_FILE: &str = "summary.csv";
-/// Run metadata.
-pub const MANIFEST_FILE: &str = "manifest.json";
+pub use whirlmap_results::files::{MANIFEST_FILE, POINTS_FILE, SUMMARY_FILE, TIMINGS_FILE};
 
 /// Why a sweep could not run or write its outputs (failed points are not errors).
 #[derive(Debug, Error)]
@@ -100,6 +93,15 @@ impl SweepError {
     }
 }
 
+impl From<whirlmap_results::WriteError> for SweepError {
+    fn from(e: whirlmap_results::WriteError) -> Self {
+        SweepError::Io {
+            path: e.path,
+            source: e.source,
+        }
+    }
+}
+
 pub(crate) fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError + '_ {
     move |source| SweepError::Io {
         path: path.to_path_buf(),
@@ -107,74 +109,7 @@ pub(crate) fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError +
     }
 }
 
-/// Outcome of one point.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Status {
-    /// The drop ran to its end.
-    Ok,
-    /// The drop failed; see `error`.
-    Failed,
-}
-
-/// A failed point's error.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PointError {
-    /// Machine-readable kind (`SolveError::kind`, or `panic`).
-    pub kind: String,
-    /// Human-readable message.
-    pub message: String,
-}
-
-/// Axis name -> value in the spec's axis order; serialises as a JSON object in that order.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Inputs(pub Vec<(String, f64)>);
-
-impl Serialize for Inputs {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut m = s.serialize_map(Some(self.0.len()))?;
-        for (k, v) in &self.0 {
-            m.serialize_entry(k, v)?;
-        }
-        m.end()
-    }
-}
-
-/// One line of `points.jsonl`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PointRecord {
-    /// [`point_key`]: 16 hex digits.
-    pub key: String,
-    /// Grid index.
-    pub index: usize,
-    /// Axis values.
-    pub inputs: Inputs,
-    /// `Scene::hash_hex` of the point's scene.
-    pub scene_hash: String,
-    /// Simulated time asked for (s).
-    pub duration_s: f64,
-    /// `whirlmap_core::MODEL_VERSION`.
-    pub model_version: u32,
-    /// `ok` or `failed`.
-    pub status: Status,
-    /// The drop record when ok.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub record: Option<DropRecord>,
-    /// The error when failed.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub error: Option<PointError>,
-    /// Wall time of the drop (s). Not in `points.jsonl` (it would break byte-identity across
-    /// runs); written to `timings.jsonl`.
-    #[serde(skip)]
-    pub wall_time_s: f64,
-}
-
-impl PointRecord {
-    /// The line written to `points.jsonl` (without the newline).
-    pub fn to_line(&self) -> String {
-        serde_json::to_string(self).expect("records serialise")
-    }
-}
+pub use whirlmap_results::point::{Inputs, PointError, PointRecord, Status};
 
 /// The record key: FNV-1a 64 of the canonical JSON of `(scene, duration_s, MODEL_VERSION)`,
 /// as 16 hex digits.
@@ -426,7 +361,7 @@ fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
     };
     let mut bytes = Vec::new();
     file.read_to_end(&mut bytes).map_err(io_err(path))?;
-    let complete = bytes.iter().rposition(|b| *b == b'\n').map_or(0, |i| i + 1);
+    let complete = whirlmap_results::read::complete_len(&bytes);
     if complete < bytes.len() {
         file.set_len(complete as u64).map_err(io_err(path))?;
         file.sync_all().map_err(io_err(path))?;
@@ -435,20 +370,17 @@ fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
         let Ok(text) = std::str::from_utf8(line) else {
             continue;
         };
-        let Ok(v) = serde_json::from_str::<Value>(text) else {
+        let Ok(p) = serde_json::from_str::<PointLine>(text) else {
             continue;
         };
-        let (Some(key), Some(status)) = (
-            v.get("key").and_then(Value::as_str),
-            v.get("status").and_then(Value::as_str),
-        ) else {
+        let (Some(key), Some(_)) = (&p.key, &p.status) else {
             continue;
         };
         map.insert(
-            key.to_string(),
+            key.clone(),
             Existing {
-                index: v.get("index").and_then(Value::as_u64),
-                ok: status == "ok",
+                index: p.index,
+                ok: p.is_ok(),
                 line: text.to_string(),
             },
         );
@@ -1059,7 +991,7 @@ mod tests {
     fn torn_last_line_is_dropped_and_truncated() {
         let dir = std::env::temp_dir().join(format!("whirlmap-sweep-unit-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let p = dir.join("points.jsonl");
+        let p = dir.join(POINTS_FILE);
         std::fs::write(
             &p,
             "{\"key\":\"a\",\"status\":\"ok\"}\n{\"key\":\"b\",\"status\":\"failed\"}\n{\"key\":\"b\",\"status\":\"ok\"}\n{\"key\":\"c\",\"sta",

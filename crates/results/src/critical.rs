@@ -1,0 +1,191 @@
+//! The rows of `critical.json` and `critical.csv`: one [`CriticalRow`] per friction
+//! coefficient of a critical-speed search, with its drops ([`Probe`]) and the optional
+//! re-check of its bracket ([`Recheck`]).
+
+use crate::files::CRITICAL_FILE;
+use crate::read::{read_json_optional, ReadError};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+use whirlmap_core::classify::OrbitClass;
+use whirlmap_core::Fidelity;
+
+/// What one drop gave: its orbit class, or a failure (solver error) with its message.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// The drop finished and was classified.
+    Class(OrbitClass),
+    /// The drop failed (typically a typed solver error, `kind: message`).
+    Failed(String),
+}
+
+impl Outcome {
+    /// Whether the drop whirled; `None` when it failed.
+    pub fn whirl(&self) -> Option<bool> {
+        match self {
+            Outcome::Class(c) => Some(c.is_whirl()),
+            Outcome::Failed(_) => None,
+        }
+    }
+}
+
+/// One drop of a search: its speed and what it gave.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Probe {
+    /// Release speed (r/min).
+    pub speed_rpm: f64,
+    /// The class, when the drop finished.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub class: Option<OrbitClass>,
+    /// The failure, when it did not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+impl Probe {
+    /// The probe of a drop at `speed_rpm` that gave `o`.
+    pub fn new(speed_rpm: f64, o: &Outcome) -> Self {
+        match o {
+            Outcome::Class(c) => Self {
+                speed_rpm,
+                class: Some(*c),
+                error: None,
+            },
+            Outcome::Failed(e) => Self {
+                speed_rpm,
+                class: None,
+                error: Some(e.clone()),
+            },
+        }
+    }
+}
+
+/// One friction coefficient's result: the row of `critical.json`, of
+/// `whirlmap critical --json` and (its scalar fields) of `critical.csv`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CriticalRow {
+    /// Friction coefficient (`mu_dynamic`).
+    pub mu: f64,
+    /// The lowest speed at which sustained whirl was found (r/min): the whirl side of the
+    /// lowest transition into whirl, or the lowest scan speed when the range already whirls
+    /// there (then `bracket_rpm` is null). Null when the range holds no whirl (`note` says
+    /// so).
+    pub onset_rpm: Option<f64>,
+    /// `[below, above]` (r/min): no whirl at `below`, whirl at `above`, at most `tol_rpm`
+    /// apart when converged. Null without a transition into whirl.
+    pub bracket_rpm: Option<[f64; 2]>,
+    /// Class at the bracket's lower end.
+    pub class_below: Option<OrbitClass>,
+    /// Class at the bracket's upper end.
+    pub class_above: Option<OrbitClass>,
+    /// Every speed interval `[first, last]` with whirl (r/min), in increasing speed: from
+    /// the whirl side of a transition into whirl (or the lowest scan speed) to the whirl side
+    /// of the transition out of it (or the range top). Gaps above the onset are where the map
+    /// is not monotone.
+    pub whirl_intervals_rpm: Vec<[f64; 2]>,
+    /// The last interval runs to the top of the range (whirl at `to_rpm`).
+    pub whirl_at_range_top: bool,
+    /// More than one whirl interval.
+    pub non_monotone: bool,
+    /// Drops run (scan and bisections, failed ones included).
+    pub drops: usize,
+    /// Drops that failed (counted as neither class; see `scan` and `bisections`).
+    pub failed_drops: usize,
+    /// Every bisection reached `tol_rpm`.
+    pub converged: bool,
+    /// Lowest speed searched (r/min).
+    pub from_rpm: f64,
+    /// Highest speed searched (r/min).
+    pub to_rpm: f64,
+    /// Lattice step of the scan (r/min).
+    pub resolution_rpm: f64,
+    /// Bisection tolerance (r/min).
+    pub tol_rpm: f64,
+    /// Simulated time of each drop before extension (s).
+    pub duration_s: f64,
+    /// `Scene::hash_hex` of the searched scene (with this `mu`; the speed varies).
+    pub scene_hash: String,
+    /// `whirlmap_core::MODEL_VERSION`.
+    pub model_version: u32,
+    /// What was found, in words.
+    pub note: String,
+    /// The scan, in speed order.
+    pub scan: Vec<Probe>,
+    /// The bisection drops, transition by transition in speed order, each in the order run.
+    pub bisections: Vec<Probe>,
+    /// The onset bracket re-run at a tighter fidelity preset, when asked for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recheck: Option<Recheck>,
+}
+
+/// The header of `critical.csv`.
+pub const CSV_HEADER: &str = "mu,onset_rpm,bracket_below_rpm,bracket_above_rpm,class_below,class_above,whirl_intervals_rpm,whirl_at_range_top,non_monotone,drops,failed_drops,converged,from_rpm,to_rpm,resolution_rpm,tol_rpm,note";
+
+impl CriticalRow {
+    /// The row's line of `critical.csv` (see [`CSV_HEADER`]): intervals as
+    /// `first-last` separated by `;`, empty cells for nulls, the note quoted.
+    pub fn csv_line(&self) -> String {
+        let opt = |v: Option<f64>| v.map_or(String::new(), |x| x.to_string());
+        let class = |c: Option<OrbitClass>| c.map_or("", |c| c.name()).to_string();
+        let intervals = self
+            .whirl_intervals_rpm
+            .iter()
+            .map(|[a, b]| format!("{a}-{b}"))
+            .collect::<Vec<_>>()
+            .join(";");
+        [
+            self.mu.to_string(),
+            opt(self.onset_rpm),
+            opt(self.bracket_rpm.map(|b| b[0])),
+            opt(self.bracket_rpm.map(|b| b[1])),
+            class(self.class_below),
+            class(self.class_above),
+            intervals,
+            self.whirl_at_range_top.to_string(),
+            self.non_monotone.to_string(),
+            self.drops.to_string(),
+            self.failed_drops.to_string(),
+            self.converged.to_string(),
+            self.from_rpm.to_string(),
+            self.to_rpm.to_string(),
+            self.resolution_rpm.to_string(),
+            self.tol_rpm.to_string(),
+            format!("\"{}\"", self.note.replace('"', "'")),
+        ]
+        .join(",")
+    }
+}
+
+/// `critical.csv`'s text for `rows`: the header and one line per row.
+pub fn csv_text(rows: &[CriticalRow]) -> String {
+    let mut s = String::from(CSV_HEADER);
+    s.push('\n');
+    for r in rows {
+        s.push_str(&r.csv_line());
+        s.push('\n');
+    }
+    s
+}
+
+/// The bracket cells of a search run again at a tighter fidelity preset.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Recheck {
+    /// The preset the cells were re-run at.
+    pub fidelity: Fidelity,
+    /// Lower bracket speed (r/min) and its outcome at that preset.
+    pub lo: (f64, Outcome),
+    /// Upper bracket speed (r/min) and its outcome at that preset.
+    pub hi: (f64, Outcome),
+    /// True when the tighter preset also gives no whirl at `lo` and whirl at `hi`.
+    pub confirmed: bool,
+}
+
+/// The text of `critical.json` for `rows` (pretty JSON, no final newline).
+pub fn critical_json(rows: &[CriticalRow]) -> String {
+    serde_json::to_string_pretty(rows).expect("results serialise")
+}
+
+/// Reads `dir/critical.json`, or `None` if it does not exist.
+pub fn read_critical(dir: &Path) -> Result<Option<Vec<CriticalRow>>, ReadError> {
+    read_json_optional(&dir.join(CRITICAL_FILE))
+}

@@ -1,0 +1,55 @@
+//! The names of the files and folders of a results folder, in one place.
+//!
+//! A sweep's folder holds [`POINTS_FILE`], [`TIMINGS_FILE`], [`SUMMARY_FILE`] and
+//! [`MANIFEST_FILE`]; its extras add [`CRITICAL_FILE`] and [`CRITICAL_CSV_FILE`],
+//! [`ORBITS_DIR`] and [`PROBABILITY_DIR`] (an ensemble's folder: [`MEMBERS_FILE`],
+//! [`CELLS_FILE`], [`CONTOURS_FILE`] and its own [`MANIFEST_FILE`]); the charts go to
+//! [`CHARTS_DIR`].
+
+/// One JSON record per grid point, in grid order.
+pub const POINTS_FILE: &str = "points.jsonl";
+/// Per-point wall times (not in [`POINTS_FILE`], whose bytes must not depend on the run).
+pub const TIMINGS_FILE: &str = "timings.jsonl";
+/// One CSV row per grid point.
+pub const SUMMARY_FILE: &str = "summary.csv";
+/// Run metadata and the list of every file the run wrote.
+pub const MANIFEST_FILE: &str = "manifest.json";
+/// Critical-speed results (a JSON list of [`crate::critical::CriticalRow`]).
+pub const CRITICAL_FILE: &str = "critical.json";
+/// The same rows as a table (one line per friction coefficient).
+pub const CRITICAL_CSV_FILE: &str = "critical.csv";
+/// Folder of the recorded orbits of Fig. 3 ([`orbit_file`], [`orbit_error_file`]).
+pub const ORBITS_DIR: &str = "orbits";
+/// Folder of the charts.
+pub const CHARTS_DIR: &str = "charts";
+/// Folder of a sweep's probability ensemble (its [`CONTOURS_FILE`] feeds Fig. 4's band).
+pub const PROBABILITY_DIR: &str = "probability";
+/// A shard's part of the grid.
+pub const SHARD_FILE: &str = "shard.json";
+/// The report of a comparison written into a results folder.
+pub const COMPARE_REPORT_FILE: &str = "compare.md";
+/// The class map of a comparison written into a results folder.
+pub const COMPARE_CLASSES_FILE: &str = "compare-classes.png";
+/// The lock file of a results folder.
+pub const LOCK_FILE: &str = ".whirlmap.lock";
+/// Where `--overwrite` keeps the previous run's files until the new run's first records are
+/// written and synced.
+pub const PREVIOUS_DIR: &str = "previous-run";
+/// An ensemble's member records, one per line.
+pub const MEMBERS_FILE: &str = "members.jsonl";
+/// An ensemble's per-cell results, one per line.
+pub const CELLS_FILE: &str = "cells.jsonl";
+/// An ensemble's probability contours.
+pub const CONTOURS_FILE: &str = "contours.json";
+/// The adaptive refinement's results.
+pub const ADAPTIVE_FILE: &str = "adaptive.json";
+
+/// The file name of a recorded orbit (in [`ORBITS_DIR`]): `stem.json`.
+pub fn orbit_file(stem: &str) -> String {
+    format!("{stem}.json")
+}
+
+/// The file name of an orbit whose drop failed (in [`ORBITS_DIR`]): `stem.error.txt`.
+pub fn orbit_error_file(stem: &str) -> String {
+    format!("{stem}.error.txt")
+}

@@ -1,0 +1,27 @@
+//! # whirlmap-results: the files of a results folder
+//!
+//! One typed layer between the model ([`whirlmap_core`]) and everything that writes or reads
+//! a results folder (sweeps, merges, charts, comparisons):
+//!
+//! - [`files`]: the name of every file and folder of a results folder, in one place.
+//! - [`record`], [`point`]: the record of one drop and the lines of `points.jsonl`, written
+//!   and read back through the same types, byte for byte.
+//! - [`critical`]: the rows of `critical.json` and `critical.csv`.
+//! - [`orbit`]: the recorded orbits of `orbits/`.
+//! - [`read`]: JSON Lines that tolerate a torn last line, whole-file JSON, typed errors that
+//!   name the file and line.
+//! - [`atomic`]: all-or-nothing writes.
+//!
+//! No threads, no charts: this crate only knows the files.
+#![warn(missing_docs)]
+
+pub mod atomic;
+pub mod critical;
+pub mod files;
+pub mod orbit;
+pub mod point;
+pub mod read;
+pub mod record;
+
+pub use atomic::{write_atomic, write_atomic_with, WriteError};
+pub use read::ReadError;
