@@ -65,7 +65,8 @@ pub enum SolveError {
     #[error(
         "energy audit failed at t = {t_s:.9} s: residual {residual_rel:.3e} above the \
          threshold {threshold:.0e} (initial {initial_j:.6e} J = final {final_j:.6e} J + \
-         losses {losses_j:.6e} J)"
+         losses {losses_j:.6e} J); the numerics created or lost that much energy: run the \
+         drop at a tighter tolerance or fidelity"
     )]
     EnergyAudit {
         /// Simulated time at the end of the drop (s).
