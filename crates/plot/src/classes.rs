@@ -5,9 +5,9 @@ use std::path::Path;
 
 use whirlmap_results::grid::Grid;
 
-use crate::axes::*;
+use crate::axes::CHART_SIZE;
 use crate::error::ChartError;
-use crate::heatmap::*;
+use crate::heatmap::{with_slice, GridFigure, GridMode};
 use crate::render::render;
 /// Draws the class map of `grid` to `path` (PNG or SVG by extension) with the cells
 /// `marked` (speed index, friction index into the grid's axes) outlined in black: the changed

@@ -4,7 +4,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 
-use crate::marks::*;
+use crate::marks::CONTOUR;
 use crate::render::{
     chart_text_style, chart_tick_formatter, DrawResult, AXIS_DESC_FONT, TICK_FONT, X_LABEL_AREA,
 };

@@ -5,7 +5,7 @@ use plotters::prelude::*;
 use whirlmap_results::grid::clamp_value;
 use whirlmap_results::orbit::OrbitFile;
 
-use crate::marks::*;
+use crate::marks::{legend, Mark};
 use crate::render::{
     chart_header, chart_quantity, decimate_samples, orbit_panel, DrawResult, Figure, CAPTION_FONT,
     CLEARANCE_COLOUR, PATH_COLOUR, TITLE_BAND, TITLE_FONT,

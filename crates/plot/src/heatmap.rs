@@ -7,15 +7,17 @@ use whirlmap_core::classify::OrbitClass;
 use whirlmap_results::grid::{clamp_value, Grid};
 use whirlmap_results::point::PointRow;
 
-use crate::axes::*;
-use crate::colour_bar::*;
+use crate::axes::{MU_DESC, SPEED_DESC};
+use crate::colour_bar::{draw_colour_bar, scale_colour};
 use crate::contour::{marching_squares, nice_levels};
-use crate::load::*;
-use crate::marks::*;
+use crate::marks::{
+    boxed_text, class_colour, cross, hatch, legend, Mark, ALL_CLASSES, CONTOUR, FAILED_BG, WHIRL_BG,
+};
 use crate::render::{
     chart_header, chart_mesh, chart_quantity, DrawResult, Figure, CAPTION_FONT, TITLE_BAND,
     TITLE_FONT, X_LABEL_AREA, Y_LABEL_AREA,
 };
+use whirlmap_results::point::PointStatus;
 
 /// Cell edges around increasing centres: midpoints, extended by half a step at the ends.
 pub(crate) fn edges(centres: &[f64]) -> Vec<f64> {

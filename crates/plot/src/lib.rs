@@ -5,7 +5,7 @@
 //! machines without system fonts. It knows the files and the model's plain types, never the
 //! engine that runs drops.
 //!
-//! - [`render_all`]: every chart of a results folder into its `charts/` (Figs. 3 to 6, the
+//! - [`render_all()`]: every chart of a results folder into its `charts/` (Figs. 3 to 6, the
 //!   class map, the peak temperature, Fig. 4 with probability bands).
 //! - One chart per file: [`fig3_orbits`], [`fig4`] (critical speeds), [`fig5`] (maximum
 //!   contact force), [`fig6`] (peak heat power), [`peak_temperature`], [`classes`] (the class

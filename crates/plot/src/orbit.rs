@@ -8,8 +8,12 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use whirlmap_core::orbit::{Orbit, OrbitSample};
 
-use crate::render::DrawResult;
-use crate::render::*;
+use crate::render::{
+    decimate_samples, draw_legend_row, draw_mesh, draw_thin_line, finite_bounds, format_quantity,
+    orbit_panel, padded_range, render, text_style, with_header, DrawResult, Figure, LegendMark,
+    RenderError, CAPTION_FONT, CLEARANCE_COLOUR, END_COLOUR, FORCE_COLOUR, PATH_COLOUR,
+    START_COLOUR, TITLE_BAND, TITLE_FONT, X_LABEL_AREA, Y_LABEL_AREA,
+};
 
 /// Size (width, height) in pixels of the orbit figure drawn by [`draw_orbit`].
 pub const ORBIT_FIGURE_SIZE: (u32, u32) = (900, 1100);

@@ -6,11 +6,11 @@ use whirlmap_results::files::CHARTS_DIR;
 use whirlmap_results::files::POINTS_FILE;
 use whirlmap_results::grid::{assemble_grid, distinct_sorted};
 
-use crate::axes::*;
+use crate::axes::CHART_SIZE;
 use crate::error::ChartError;
-use crate::fig3_orbits::*;
+use crate::fig3_orbits::{orbit_figure_size, OrbitPanels};
 use crate::fig4::{band_points, Fig4};
-use crate::load::*;
+use crate::load::{load_critical, load_orbits, load_points, load_probability};
 use crate::render::{chart_quantity, render, Figure};
 
 pub(crate) fn write_both<F: Figure>(
