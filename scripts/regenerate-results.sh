@@ -35,7 +35,7 @@ for part in "${parts[@]}"; do
       cargo run --release --quiet -p whirlmap-sweep --example convergence ;;
     physics)
       rm -rf results/physics
-      cargo run --release --quiet -p whirlmap-sweep --example physics ;;
+      cargo run --release --quiet --example physics ;;
     nightly)
       rm -rf results/nightly-baseline
       "$W" sweep sweeps/nightly.json --out results/nightly-baseline --no-progress ;;

@@ -7,8 +7,8 @@
 use crate::Failure;
 use anyhow::Context;
 use std::path::PathBuf;
-use whirlmap_sweep::accuracy::{run, to_csv, to_markdown, AccuracySpec, AccuracySpecError};
-use whirlmap_sweep::accuracy_chart::{draw_work_precision, CostAxis};
+use whirlmap_plot::accuracy::{draw_work_precision, CostAxis, RunCost, StudyRun};
+use whirlmap_sweep::accuracy::{run, to_csv, to_markdown, AccuracySpec, AccuracySpecError, Study};
 
 /// Arguments of `whirlmap accuracy`.
 #[derive(clap::Args)]
@@ -62,6 +62,7 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
         "study.json",
         serde_json::to_string_pretty(&study).expect("a study serialises"),
     )?;
+    let (cases, runs) = chart_runs(&study);
     for (axis, stem) in [
         (CostAxis::RhsEvals, "work_precision"),
         (CostAxis::WallMs, "work_precision_wall"),
@@ -69,10 +70,33 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
         for ext in ["png", "svg"] {
             let p = a.out.join(format!("{stem}.{ext}"));
             let title = format!("Work-precision: {} (reference DOP853)", spec.name);
-            draw_work_precision(&p, &study, axis, &title).map_err(|e| Failure::Output(e.into()))?;
+            draw_work_precision(&p, &cases, &runs, axis, &title)
+                .map_err(|e| Failure::Output(e.into()))?;
         }
     }
     outln!("{md}");
     errln!("written to {}", a.out.display());
     Ok(())
+}
+
+/// The study as the work-precision chart takes it: the cases in order, and every run reduced
+/// to its cost and worst relative error.
+fn chart_runs(study: &Study) -> (Vec<String>, Vec<StudyRun>) {
+    let cases = study.references.iter().map(|r| r.case.clone()).collect();
+    let runs = study
+        .rows
+        .iter()
+        .map(|r| StudyRun {
+            case: r.case.clone(),
+            setting: r.setting.clone(),
+            rtol: r.rtol,
+            cost: r.result.as_ref().ok().map(|(m, e)| RunCost {
+                rhs_evals: m.rhs_evals,
+                wall_ms: m.wall_ms,
+                worst_rel: e.worst_rel(),
+                class_agrees: e.class_agrees,
+            }),
+        })
+        .collect();
+    (cases, runs)
 }

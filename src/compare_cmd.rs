@@ -5,7 +5,7 @@
 //! report). Differences between the two specs are always printed.
 
 use std::path::PathBuf;
-use whirlmap_sweep::compare::{compare, write_report, Thresholds};
+use whirlmap_sweep::compare::{compare, write_report, ClassMap, Thresholds};
 
 /// Arguments of `whirlmap compare`.
 #[derive(clap::Args)]
@@ -47,7 +47,11 @@ pub fn run(a: &CompareArgs) -> u8 {
         errln!("warning: {w}");
     }
     let out = a.out.clone().unwrap_or_else(|| a.new.join("compare.md"));
-    let png = match write_report(&c, &out) {
+    let draw = |m: &ClassMap| {
+        whirlmap_plot::classes::draw_marked_class_map(m.path, m.grid, m.title, m.marked)
+            .map_err(|e| e.to_string())
+    };
+    let png = match write_report(&c, &out, &draw) {
         Ok(p) => p,
         Err(e) => {
             errln!("error: {e}");

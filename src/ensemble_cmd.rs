@@ -106,7 +106,7 @@ pub fn run_ensemble_cmd(a: &EnsembleArgs) -> u8 {
         };
         outln!("  {label}: {} r/min{flag}", levels.join(", "));
     }
-    match whirlmap_sweep::prob_chart::render_probability(&out) {
+    match whirlmap_plot::probability::render_probability(&out) {
         Ok(w) => outln!("  output           {} ({} charts)", out.display(), w.len()),
         Err(e) => {
             errln!("error: charts: {e}");

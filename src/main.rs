@@ -13,10 +13,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 use whirlmap_core::{simulate, DropOptions, DropReport, Scene};
+use whirlmap_plot::render::{draw_orbit, ImageFormat};
+use whirlmap_plot::thermal::draw_temperatures;
 use whirlmap_sweep::overrides::apply_assignment;
 use whirlmap_sweep::record::DropRecord;
-use whirlmap_sweep::render::{draw_orbit, ImageFormat};
-use whirlmap_sweep::thermal_chart::draw_temperatures;
 
 mod accuracy_cmd;
 mod bench;

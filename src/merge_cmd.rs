@@ -1,5 +1,5 @@
 //! `whirlmap merge DIR... [--out DIR]`: join the shards of a sweep into one result (see
-//! `whirlmap_sweep::merge`).
+//! `whirlmap_sweep::merge`; the charts are drawn by `whirlmap_plot`).
 //!
 //! Exit codes: 0 merged, every point ok; 1 merged, some point failed (recorded as data); 2
 //! refused (a point missing or present twice, shards of different specs, shard counts,
@@ -8,7 +8,7 @@
 //! without --overwrite) with every problem listed; 4 an output could not be written.
 
 use std::path::PathBuf;
-use whirlmap_sweep::merge::merge;
+use whirlmap_sweep::merge::{merge, ChartsFailed};
 
 /// Arguments of `whirlmap merge`.
 #[derive(clap::Args)]
@@ -38,7 +38,13 @@ pub fn run(a: &MergeArgs) -> u8 {
             }
         },
     };
-    match merge(&a.dirs, &out, a.overwrite) {
+    let draw = |dir: &std::path::Path| {
+        whirlmap_plot::render_all(dir).map_err(|e| ChartsFailed {
+            message: e.to_string(),
+            output: e.is_output(),
+        })
+    };
+    match merge(&a.dirs, &out, a.overwrite, &draw) {
         Ok(o) => {
             for w in &o.warnings {
                 errln!("warning: {w}");

@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 
-use whirlmap_sweep::charts::{render_all, ChartError};
+use whirlmap_plot::{render_all, ChartError};
 use whirlmap_sweep::folder::{self, FolderLock};
 
 /// Arguments of `whirlmap render`.

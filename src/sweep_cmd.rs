@@ -123,7 +123,7 @@ pub fn run(a: &SweepArgs) -> u8 {
         }
     }
     if !spec.charts.is_empty() {
-        match whirlmap_sweep::charts::render_all(&dir) {
+        match whirlmap_plot::render_all(&dir) {
             Ok(written) => outln!("  charts           {} files", written.len()),
             Err(e) => {
                 errln!("error: charts: {e}");

@@ -8,6 +8,9 @@
 //!   and read back through the same types, byte for byte.
 //! - [`critical`]: the rows of `critical.json` and `critical.csv`.
 //! - [`orbit`]: the recorded orbits of `orbits/`.
+//! - [`contours`]: an ensemble's `contours.json`.
+//! - [`grid`]: the points arranged over release speed and friction (the grid charts, a
+//!   comparison's changed cells).
 //! - [`read`]: JSON Lines that tolerate a torn last line, whole-file JSON, typed errors that
 //!   name the file and line.
 //! - [`atomic`]: all-or-nothing writes.
@@ -16,12 +19,14 @@
 #![warn(missing_docs)]
 
 pub mod atomic;
+pub mod contours;
 pub mod critical;
 pub mod files;
+pub mod grid;
 pub mod orbit;
 pub mod point;
 pub mod read;
 pub mod record;
 
 pub use atomic::{write_atomic, write_atomic_with, WriteError};
-pub use read::ReadError;
+pub use read::{LoadError, ReadError};

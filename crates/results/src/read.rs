@@ -40,6 +40,57 @@ pub enum ReadError {
     },
 }
 
+/// Why a reader of a results folder (the charts, a comparison) could not take its inputs, in
+/// the words those readers print: a missing `points.jsonl` means "no sweep results".
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    /// The results directory has no `points.jsonl`.
+    #[error("no sweep results: {} does not exist", path.display())]
+    NoPoints {
+        /// The missing file.
+        path: PathBuf,
+    },
+    /// An input file could not be read.
+    #[error("cannot read {}: {cause}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        cause: std::io::Error,
+    },
+    /// An input file is not what it should be (a torn last line of points.jsonl is not).
+    #[error("{}: line {line}: {message}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number (1 for whole-file JSON).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl From<ReadError> for LoadError {
+    fn from(e: ReadError) -> Self {
+        match e {
+            ReadError::NotFound { path } => LoadError::NoPoints { path },
+            ReadError::Io { path, source } => LoadError::Read {
+                path,
+                cause: source,
+            },
+            ReadError::Parse {
+                path,
+                line,
+                message,
+            } => LoadError::Parse {
+                path,
+                line,
+                message,
+            },
+        }
+    }
+}
+
 /// A final line without its newline that did not parse: a write torn by a crash.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TornLine {

@@ -22,7 +22,8 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
-use whirlmap_sweep::charts::{load_critical, load_points, PointRow, PointStatus};
+use whirlmap_results::critical::read_critical;
+use whirlmap_results::point::{load_points, PointRow, PointStatus};
 use whirlmap_sweep::critical::CriticalRow;
 
 fn main() {
@@ -38,10 +39,10 @@ fn main() {
         load_points(&ref_dir).expect("reference points"),
     );
     let (ca, cb) = (
-        load_critical(&std_dir)
+        read_critical(&std_dir)
             .expect("standard critical.json")
             .expect("a critical search"),
-        load_critical(&ref_dir)
+        read_critical(&ref_dir)
             .expect("reference critical.json")
             .expect("a critical search"),
     );

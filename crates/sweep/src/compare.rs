@@ -18,16 +18,18 @@
 //!   being written is refused, a run that did not finish is said loudly.
 //!
 //! [`compare`] returns the findings; [`write_report`] writes them as Markdown with a class map
-//! of the new run whose changed cells are outlined.
+//! of the new run whose changed cells are outlined (drawn by the function its caller hands
+//! in: this crate draws nothing).
 
-use crate::charts::{assemble_grid, draw_marked_class_map, ChartError};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use whirlmap_results::critical::{read_critical, CriticalRow};
 use whirlmap_results::files::MANIFEST_FILE;
+use whirlmap_results::grid::{assemble_grid, Grid};
 use whirlmap_results::point::{load_points, PointRow, PointStatus};
+use whirlmap_results::read::LoadError;
 
 /// Relative changes above which a point counts as changed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -145,7 +147,7 @@ pub struct RunInfo {
 pub enum CompareError {
     /// A folder's points or critical speeds could not be read.
     #[error(transparent)]
-    Read(#[from] ChartError),
+    Read(#[from] LoadError),
     /// The folders cannot be compared: nothing comparable, a folder being written, a file
     /// its run did not write. Every reason, one per entry.
     #[error("compare refused:\n  - {}", .0.join("\n  - "))]
@@ -340,8 +342,8 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
         return Err(CompareError::Refused(refused));
     }
     let spec_differences = specs_differ(baseline, new);
-    let base_rows = load_points(baseline).map_err(ChartError::from)?;
-    let new_rows = load_points(new).map_err(ChartError::from)?;
+    let base_rows = load_points(baseline).map_err(LoadError::from)?;
+    let new_rows = load_points(new).map_err(LoadError::from)?;
     let mut base_by: BTreeMap<String, &PointRow> = BTreeMap::new();
     for r in &base_rows {
         base_by.insert(inputs_key(r), r); // a rerun line replaces an earlier one
@@ -428,8 +430,8 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
         return Err(CompareError::Refused(why));
     }
     let (critical_compared, critical) = match (
-        read_critical(baseline).map_err(ChartError::from)?,
-        read_critical(new).map_err(ChartError::from)?,
+        read_critical(baseline).map_err(LoadError::from)?,
+        read_critical(new).map_err(LoadError::from)?,
     ) {
         (None, None) => (0, Vec::new()),
         (b, n) => {
@@ -467,12 +469,47 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
     })
 }
 
-/// Writes the Markdown report to `path` and the class map of the new run with the changed
-/// cells outlined beside it (`<stem>-classes.png`). Returns the image's path.
-pub fn write_report(c: &Comparison, path: &Path) -> Result<PathBuf, ChartError> {
+/// The class map beside a report: the new run's grid with the changed cells marked, for the
+/// caller of [`write_report`] to draw.
+#[derive(Debug, Clone, Copy)]
+pub struct ClassMap<'a> {
+    /// The image to write (`<stem>-classes.png` beside the report).
+    pub path: &'a Path,
+    /// The new run's points over speed and friction.
+    pub grid: &'a Grid,
+    /// The chart's title.
+    pub title: &'a str,
+    /// The changed cells, as (speed index, friction index) into the grid's axes.
+    pub marked: &'a [(usize, usize)],
+}
+
+/// Why a report could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// The report's folder or the report could not be written.
+    #[error("cannot create {}: {cause}", path.display())]
+    Write {
+        /// The folder or file.
+        path: PathBuf,
+        /// The I/O error.
+        cause: std::io::Error,
+    },
+    /// The class map could not be drawn, in the drawing's words.
+    #[error("{0}")]
+    Draw(String),
+}
+
+/// Writes the Markdown report to `path` and, with `draw_class_map`, the class map of the new
+/// run with the changed cells outlined beside it (`<stem>-classes.png`), before the report.
+/// Returns the image's path.
+pub fn write_report(
+    c: &Comparison,
+    path: &Path,
+    draw_class_map: &dyn Fn(&ClassMap) -> Result<(), String>,
+) -> Result<PathBuf, ReportError> {
     let write_err = |path: &Path| {
         let path = path.to_path_buf();
-        move |cause| ChartError::Write { path, cause }
+        move |cause| ReportError::Write { path, cause }
     };
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(write_err(dir))?;
@@ -496,12 +533,13 @@ pub fn write_report(c: &Comparison, path: &Path) -> Result<PathBuf, ChartError> 
             }
         }
     }
-    draw_marked_class_map(
-        &png,
-        &grid,
-        "Orbit class of the new run; changed cells outlined",
-        &marked,
-    )?;
+    draw_class_map(&ClassMap {
+        path: &png,
+        grid: &grid,
+        title: "Orbit class of the new run; changed cells outlined",
+        marked: &marked,
+    })
+    .map_err(ReportError::Draw)?;
 
     let t = &c.thresholds;
     let mut md = String::new();

@@ -70,6 +70,7 @@ use whirlmap_core::Scene;
 
 /// Per-cell statistics as CSV.
 pub const CELLS_CSV: &str = "cells.csv";
+pub use whirlmap_results::contours::{ContourGroup, ContoursFile, LevelCrossing};
 pub use whirlmap_results::files::{CELLS_FILE, CONTOURS_FILE, MANIFEST_FILE, MEMBERS_FILE};
 
 /// SplitMix64 (Steele, Lea, Flood 2014): a 64-bit state advanced by a Weyl sequence and
@@ -733,38 +734,6 @@ pub fn run_members(
         .collect()
 }
 
-/// One crossing level of a contour group.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct LevelCrossing {
-    /// The probability level.
-    pub level: f64,
-    /// Speed where P(whirl) first reaches the level (r/min); `None`: not in the range.
-    pub speed_rpm: Option<f64>,
-    /// Lower end of the interval (where the Wilson upper bound reaches the level); `None`:
-    /// below the lowest speed of the grid.
-    pub speed_lo_rpm: Option<f64>,
-    /// Upper end (where the Wilson lower bound reaches the level); `None`: above the
-    /// highest speed of the grid.
-    pub speed_hi_rpm: Option<f64>,
-    /// What was found, in words.
-    pub note: String,
-}
-
-/// The contours of one group of cells (one mu, for a speed x mu grid).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ContourGroup {
-    /// Every input but `speed_rpm`.
-    pub inputs: BTreeMap<String, f64>,
-    /// The cells' speeds, ascending (r/min).
-    pub speeds_rpm: Vec<f64>,
-    /// P(whirl) at those speeds (`None`: no member finished).
-    pub p_whirl: Vec<Option<f64>>,
-    /// One entry per level.
-    pub levels: Vec<LevelCrossing>,
-    /// P falls with speed by more than the intervals allow somewhere.
-    pub non_monotone: bool,
-}
-
 /// Where the piecewise-linear `p(speed)` first reaches `level`: `Ok(speed)`, or
 /// `Err(true)` if already at or above it at the lowest speed, `Err(false)` if never.
 /// Points with a non-finite value are skipped.
@@ -848,19 +817,6 @@ pub fn contours(cells: &[CellStats], levels: &[f64]) -> Vec<ContourGroup> {
 
 fn speed(c: &CellStats) -> f64 {
     c.inputs.get("speed_rpm").copied().unwrap_or(f64::NAN)
-}
-
-/// The contents of `contours.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ContoursFile {
-    /// Spec name.
-    pub name: String,
-    /// Members per cell.
-    pub members: usize,
-    /// Confidence of the intervals.
-    pub confidence: f64,
-    /// One group per combination of the non-speed inputs.
-    pub groups: Vec<ContourGroup>,
 }
 
 /// What an ensemble run did.

@@ -1,5 +1,5 @@
 //! What a sweep spec asks for beside its grid: the critical-speed search (`critical.json`)
-//! and the orbits of the Fig. 3 chart (`orbits/*.json`), in the forms [`crate::charts`] reads.
+//! and the orbits of the Fig. 3 chart (`orbits/*.json`), in the forms the charts (`whirlmap-plot`) read.
 
 use crate::critical::{critical_rows, csv_text, CriticalRow};
 use crate::run::run_drop;

@@ -1,11 +1,10 @@
-//! # whirlmap-sweep: classification, records and charts on top of whirlmap-core
+//! # whirlmap-sweep: classification, sweeps, searches and ensembles on top of whirlmap-core
 //!
 //! - [`classify`]: the orbit class as a pure function of a drop's streamed features.
 //! - [`record`]: the JSON record of one drop (the output contract), re-exported from
 //!   [`results`] (`whirlmap-results`: the files of a results folder, their names and typed
 //!   rows, JSONL reading, atomic writes).
 //! - [`overrides`]: scene parameters set by name (`--set key=value`, sweep axes).
-//! - [`render`] and [`fonts`]: charts with an embedded font (no system fonts needed).
 //! - [`spec`] and [`sweep`]: sweep specs (JSON grids over scene parameters) and the
 //!   parallel, crash-safe, resumable sweep engine (`points.jsonl`, `summary.csv`, manifest).
 //! - [`folder`]: a results folder's lock, its manifest's file list and the checks of a
@@ -14,12 +13,12 @@
 //!   sweep's grid runs).
 //! - [`shard`] and [`merge`]: a sweep split over machines and joined again.
 //! - [`compare`]: what changed between two results (nightly jobs).
-//! - [`charts`]: the design charts (Figs. 3 to 6, class map) from a sweep's results.
-//! - [`accuracy`] and [`accuracy_chart`]: the work-precision study (`whirlmap accuracy`).
-//! - [`thermal_chart`]: node temperatures and thermal load of one thermal drop over time.
+//! - [`accuracy`]: the work-precision study (`whirlmap accuracy`).
 //! - [`ensemble`]: whirl probability per cell (seeded ensembles of drops), probability
-//!   contours; [`prob_chart`]: Fig. 4 drawn with them; [`adaptive`]: adaptive refinement of
-//!   the whirl boundary.
+//!   contours; [`adaptive`]: adaptive refinement of the whirl boundary.
+//!
+//! No charts: drawing is `whirlmap-plot`'s, which reads what this crate writes. A merge
+//! and a comparison take the drawing as a function from their caller.
 #![warn(missing_docs)]
 // `!(x <= bound)` on purpose: a NaN fails the check instead of passing it.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -27,29 +26,22 @@
 pub use whirlmap_results as results;
 
 pub mod accuracy;
-pub mod accuracy_chart;
 pub mod adaptive;
 pub mod build_info;
-pub mod charts;
 pub mod classify;
 pub mod compare;
 pub mod critical;
 pub mod ensemble;
 pub mod extras;
 pub mod extremes;
-pub mod fig4;
 pub mod folder;
-pub mod fonts;
 pub mod merge;
 pub mod ordered;
 pub mod overrides;
 pub mod pool;
-pub mod prob_chart;
 pub mod recheck;
 pub mod record;
-pub mod render;
 pub mod run;
 pub mod shard;
 pub mod spec;
 pub mod sweep;
-pub mod thermal_chart;

@@ -16,11 +16,11 @@
 //! `summary.csv`, `critical.json` and `orbits/` byte-identical to a single-machine run of the
 //! same spec, a `manifest.json` of the same form (counts and classes identical; run times,
 //! threads and build taken from the shards, plus `merged_from`), `timings.jsonl` (the
-//! shards' wall times in grid order), and the charts. The output folder is taken as a sweep
+//! shards' wall times in grid order), and the charts (drawn by the function its caller hands
+//! in: this crate draws nothing). The output folder is taken as a sweep
 //! takes it ([`crate::folder`]): locked, and refused when it holds another run's files
 //! unless `overwrite`.
 
-use crate::charts::{render_all, ChartError};
 use crate::extras::{orbit_panels, write_critical, CRITICAL_FILE, PROBABILITY_DIR};
 use crate::folder::{self, Mode, RunFolder, RunIdentity};
 use crate::shard::{read_shard_manifest, spec_hash, Shard, ShardManifest};
@@ -57,7 +57,17 @@ pub enum MergeError {
     Output(#[from] SweepError),
     /// The charts could not be drawn.
     #[error("charts: {0}")]
-    Charts(#[from] ChartError),
+    Charts(#[from] ChartsFailed),
+}
+
+/// Why the chart drawing handed to [`merge`] failed, as its caller words it.
+#[derive(Debug, Error)]
+#[error("{message}")]
+pub struct ChartsFailed {
+    /// What went wrong.
+    pub message: String,
+    /// Whether an output could not be written (exit code 4) rather than an input read (2).
+    pub output: bool,
 }
 
 impl MergeError {
@@ -66,7 +76,7 @@ impl MergeError {
         match self {
             MergeError::Refused(_) | MergeError::Spec(_) => 2,
             MergeError::Output(e) => e.exit_code(),
-            MergeError::Charts(e) if e.is_output() => 4,
+            MergeError::Charts(e) if e.output => 4,
             MergeError::Charts(_) => 2,
         }
     }
@@ -233,12 +243,15 @@ fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardDir>, MergeError> {
     Ok(shards)
 }
 
-/// Merges the shard folders `dirs` into `out_dir` (see the module docs); draws the charts
-/// the spec lists. `out_dir` must not be one of the shard folders.
+/// Merges the shard folders `dirs` into `out_dir` (see the module docs). When the spec lists
+/// charts, `draw_charts` draws them from the merged folder (the records written, the folder
+/// still locked, before the manifest is completed) and returns the files it wrote, which the
+/// manifest then lists. `out_dir` must not be one of the shard folders.
 pub fn merge(
     dirs: &[PathBuf],
     out_dir: &Path,
     overwrite: bool,
+    draw_charts: &dyn Fn(&Path) -> Result<Vec<PathBuf>, ChartsFailed>,
 ) -> Result<MergeOutcome, MergeError> {
     let shards = read_shards(dirs)?;
     let spec = shards[0].m.spec.clone();
@@ -614,7 +627,7 @@ pub fn merge(
     let charts = if spec.charts.is_empty() {
         Vec::new()
     } else {
-        render_all(out_dir)?
+        draw_charts(out_dir)?
     };
     out.record_tree(CHARTS_DIR)?;
     record.meta.ended_unix_s = merged_end(&shards);

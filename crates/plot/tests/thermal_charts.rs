@@ -2,7 +2,7 @@
 //! the thermal model's temperatures.
 
 use serde_json::json;
-use whirlmap_sweep::charts::{load_points, render_all};
+use whirlmap_plot::{load_points, render_all};
 
 #[test]
 fn peak_temperature_chart_is_drawn_from_records_with_temperatures() {

@@ -21,9 +21,12 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::charts::{arrow, clamp_value, legend, triangle_up, Mark, BAND, MU_DESC};
-use crate::critical::CriticalRow;
-use crate::ensemble::ContoursFile;
+use whirlmap_results::contours::ContoursFile;
+use whirlmap_results::critical::CriticalRow;
+use whirlmap_results::grid::clamp_value;
+
+use crate::axes::MU_DESC;
+use crate::marks::{arrow, legend, triangle_up, Mark, BAND};
 use crate::render::{
     chart_header, chart_mesh, chart_quantity, chart_text_style, DrawResult, Figure, TITLE_BAND,
     TITLE_FONT, X_LABEL_AREA, Y_LABEL_AREA,
@@ -304,8 +307,8 @@ impl IntoRgb for RGBAColor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ensemble::{ContourGroup, LevelCrossing};
     use std::collections::BTreeMap;
+    use whirlmap_results::contours::{ContourGroup, LevelCrossing};
 
     fn group(mu: f64, p: &[f64], crossings: [Option<f64>; 3]) -> ContourGroup {
         ContourGroup {

@@ -3,9 +3,11 @@
 use std::path::{Path, PathBuf};
 
 use serde_json::json;
-use whirlmap_sweep::charts::{load_points, render_all, ChartError, PointStatus};
-use whirlmap_sweep::classify::OrbitClass;
-use whirlmap_sweep::critical::{CriticalOptions, CriticalRow, Probe, SearchResult};
+use whirlmap_core::classify::OrbitClass;
+use whirlmap_core::MODEL_VERSION;
+use whirlmap_plot::{load_points, render_all, ChartError};
+use whirlmap_results::critical::{CriticalRow, Probe};
+use whirlmap_results::point::PointStatus;
 
 const SPEEDS: [f64; 6] = [2000.0, 4000.0, 6000.0, 8000.0, 10000.0, 12000.0];
 const MUS: [f64; 5] = [0.05, 0.1, 0.15, 0.2, 0.3];
@@ -108,13 +110,6 @@ pub fn write_synthetic(dir: &Path, orbits: usize) {
 /// to the range top otherwise.
 fn critical_row(mu: f64) -> CriticalRow {
     let crit = 11000.0 - 30000.0 * mu;
-    let o = CriticalOptions {
-        from_rpm: 1000.0,
-        to_rpm: 12000.0,
-        resolution_rpm: 250.0,
-        tol_rpm: 25.0,
-        duration_s: 1.0,
-    };
     let (onset, intervals, top) = if mu == 0.05 {
         (None, vec![], false)
     } else if mu == 0.2 {
@@ -122,23 +117,34 @@ fn critical_row(mu: f64) -> CriticalRow {
     } else {
         (Some(crit), vec![[crit, 12000.0]], true)
     };
-    SearchResult {
+    CriticalRow {
+        mu,
         onset_rpm: onset,
         bracket_rpm: onset.map(|c| [c - 20.0, c]),
         class_below: onset.map(|_| OrbitClass::Pendulum),
         class_above: onset.map(|_| OrbitClass::BackwardWhirl),
+        non_monotone: intervals.len() > 1,
         whirl_intervals_rpm: intervals,
         whirl_at_range_top: top,
+        drops: 1,
+        failed_drops: 0,
         converged: true,
+        from_rpm: 1000.0,
+        to_rpm: 12000.0,
+        resolution_rpm: 250.0,
+        tol_rpm: 25.0,
+        duration_s: 1.0,
+        scene_hash: "abc".into(),
+        model_version: MODEL_VERSION,
+        note: String::new(),
         scan: vec![Probe {
             speed_rpm: 1000.0,
             class: Some(OrbitClass::Pendulum),
             error: None,
         }],
         bisections: vec![],
-        note: String::new(),
+        recheck: None,
     }
-    .into_row(mu, &o, "abc".into())
 }
 
 #[test]

@@ -9,7 +9,7 @@ use std::process::Command;
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use whirlmap_core::orbit::{Orbit, OrbitSample};
-use whirlmap_sweep::render::{draw_orbit, ImageFormat, RenderError};
+use whirlmap_plot::render::{draw_orbit, ImageFormat, RenderError};
 
 /// When set, [`child_renders_into_dir`] renders into the directory it names.
 const CHILD_ENV: &str = "WHIRLMAP_RENDER_CHILD_DIR";

@@ -15,15 +15,10 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use whirlmap_core::orbit::{Orbit, OrbitSample};
+use whirlmap_core::orbit::OrbitSample;
 
 use crate::fonts::{self, FontError, FONT_FAMILY};
-
-/// Size (width, height) in pixels of the orbit figure drawn by [`draw_orbit`].
-pub const ORBIT_FIGURE_SIZE: (u32, u32) = (900, 1100);
-
-/// Most samples [`draw_orbit`] draws; longer orbits are thinned by [`decimate_samples`].
-pub const MAX_DRAWN_SAMPLES: usize = 20_000;
+pub use crate::orbit::{draw_orbit, MAX_DRAWN_SAMPLES, ORBIT_FIGURE_SIZE};
 
 /// Image file format, chosen from the output path's extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -125,28 +120,13 @@ pub fn render<F: Figure>(path: &Path, size: (u32, u32), figure: &F) -> Result<()
     result
 }
 
-fn draw_and_present<DB: DrawingBackend, F: Figure>(
+pub(crate) fn draw_and_present<DB: DrawingBackend, F: Figure>(
     root: &DrawingArea<DB, Shift>,
     figure: &F,
 ) -> DrawResult<DB> {
     root.fill(&WHITE)?;
     figure.draw(root)?;
     root.present()
-}
-
-/// Draws a recorded orbit, the paper's Fig. 3 view, to `path` (`.png` or `.svg`).
-///
-/// Top: the rotor centre's path relative to the race in µm, equal aspect, inside the dashed
-/// clearance circle, with the release and final positions marked. Bottom: the contact force
-/// against time. Orbits longer than [`MAX_DRAWN_SAMPLES`] are thinned for drawing by
-/// [`decimate_samples`], which keeps every bucket's force peak.
-pub fn draw_orbit(path: &Path, title: &str, orbit: &Orbit) -> Result<(), RenderError> {
-    let figure = OrbitFigure {
-        title,
-        clearance_m: orbit.clearance_m,
-        samples: decimate_samples(&orbit.samples, MAX_DRAWN_SAMPLES),
-    };
-    render(path, ORBIT_FIGURE_SIZE, &figure)
 }
 
 /// Thins `samples` to at most `max_points` (at least 4) for drawing.
@@ -272,22 +252,22 @@ pub const X_LABEL_AREA: u32 = 58;
 /// Space for the y tick labels and axis description left of a plot (px).
 pub const Y_LABEL_AREA: u32 = 82;
 
-const TEXT_COLOUR: RGBColor = RGBColor(30, 30, 30);
+pub(crate) const TEXT_COLOUR: RGBColor = RGBColor(30, 30, 30);
 pub(crate) const AXIS_COLOUR: RGBColor = RGBColor(90, 90, 90);
 pub(crate) const GRID_BOLD: RGBColor = RGBColor(212, 212, 212);
 pub(crate) const GRID_LIGHT: RGBColor = RGBColor(236, 236, 236);
 pub(crate) const PATH_COLOUR: RGBColor = RGBColor(31, 119, 180);
-const FORCE_COLOUR: RGBColor = RGBColor(190, 50, 40);
+pub(crate) const FORCE_COLOUR: RGBColor = RGBColor(190, 50, 40);
 pub(crate) const CLEARANCE_COLOUR: RGBColor = RGBColor(120, 120, 120);
-const START_COLOUR: RGBColor = RGBColor(44, 160, 44);
-const END_COLOUR: RGBColor = RGBColor(214, 39, 40);
+pub(crate) const START_COLOUR: RGBColor = RGBColor(44, 160, 44);
+pub(crate) const END_COLOUR: RGBColor = RGBColor(214, 39, 40);
 
 pub(crate) fn text_style(size: f64) -> TextStyle<'static> {
     TextStyle::from((FONT_FAMILY, size).into_font()).color(&TEXT_COLOUR)
 }
 
 /// Draws `text` centred in `area`, shrinking the font (down to 12 px) so it fits the width.
-fn draw_centered_text<DB: DrawingBackend>(
+pub(crate) fn draw_centered_text<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     text: &str,
     size: f64,
@@ -367,7 +347,7 @@ pub(crate) fn draw_legend_row<DB: DrawingBackend>(
 
 /// A tick-label formatter for an axis spanning `span`: enough decimals for the tick step,
 /// trailing zeros trimmed, scientific notation for very large or small values.
-fn tick_formatter(span: f64) -> impl Fn(&f64) -> String {
+pub(crate) fn tick_formatter(span: f64) -> impl Fn(&f64) -> String {
     let span = if span.is_finite() && span > 0.0 {
         span
     } else {
@@ -388,7 +368,7 @@ fn tick_formatter(span: f64) -> impl Fn(&f64) -> String {
 }
 
 /// `"2.50"` to `"2.5"`, `"3.00"` to `"3"`; integers unchanged.
-fn trim_decimal_zeros(s: &str) -> &str {
+pub(crate) fn trim_decimal_zeros(s: &str) -> &str {
     if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.')
     } else {
@@ -397,7 +377,7 @@ fn trim_decimal_zeros(s: &str) -> &str {
 }
 
 /// `value` with about three significant digits, for captions.
-fn format_quantity(value: f64) -> String {
+pub(crate) fn format_quantity(value: f64) -> String {
     let a = value.abs();
     if !value.is_finite() {
         "n/a".to_string()
@@ -414,10 +394,10 @@ fn format_quantity(value: f64) -> String {
 
 /// Largest magnitude an axis range reaches: keeps spans and padding finite (plotters hangs
 /// on infinite ranges) when a blown-up solution records values near `f64::MAX`.
-const AXIS_LIMIT: f64 = 1e300;
+pub(crate) const AXIS_LIMIT: f64 = 1e300;
 
 /// (min, max) of the finite values, clamped to [`AXIS_LIMIT`], or `None` if there are none.
-fn finite_bounds(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
+pub(crate) fn finite_bounds(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
     values
         .into_iter()
         .filter(|v| v.is_finite())
@@ -429,7 +409,7 @@ fn finite_bounds(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
 }
 
 /// A non-degenerate axis range from optional data bounds, widened by `pad` of its span.
-fn padded_range(bounds: Option<(f64, f64)>, pad: f64) -> (f64, f64) {
+pub(crate) fn padded_range(bounds: Option<(f64, f64)>, pad: f64) -> (f64, f64) {
     match bounds {
         None => (0.0, 1.0),
         Some((lo, hi)) if hi - lo > 0.0 && (hi - lo).is_finite() => {
@@ -444,7 +424,7 @@ fn padded_range(bounds: Option<(f64, f64)>, pad: f64) -> (f64, f64) {
 }
 
 /// Applies the common axis styling (fonts, grid, units, tick formats) to `chart`'s mesh.
-fn draw_mesh<DB: DrawingBackend>(
+pub(crate) fn draw_mesh<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     x_desc: &str,
     y_desc: &str,
@@ -492,125 +472,6 @@ pub(crate) fn draw_thin_line<DB: DrawingBackend>(
         chart.draw_series(points.iter().map(|&p| Pixel::new(p, colour)))?;
     }
     Ok(())
-}
-
-// ---------------------------------------------------------------------------------------------
-// The orbit figure.
-
-struct OrbitFigure<'a> {
-    title: &'a str,
-    clearance_m: f64,
-    samples: Vec<OrbitSample>,
-}
-
-/// Fraction of the area below the title given to the orbit (top) panel.
-const ORBIT_PANEL_SHARE: f64 = 0.655;
-
-impl Figure for OrbitFigure<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let body = with_header(root, TITLE_BAND, self.title, TITLE_FONT)?;
-        let top_h = (body.dim_in_pixel().1 as f64 * ORBIT_PANEL_SHARE).round() as u32;
-        let (top, bottom) = body.split_vertically(top_h);
-        self.draw_path_panel(&top)?;
-        self.draw_force_panel(&bottom)
-    }
-}
-
-impl OrbitFigure<'_> {
-    fn clearance_um(&self) -> Option<f64> {
-        let c = self.clearance_m * 1e6;
-        (c.is_finite() && c > 0.0).then_some(c)
-    }
-
-    /// Top panel: rotor-centre path relative to the race, equal aspect, clearance circle.
-    fn draw_path_panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let path: Vec<(f64, f64)> = self
-            .samples
-            .iter()
-            .map(|s| (s.x_rel_m * 1e6, s.y_rel_m * 1e6))
-            .filter(|(x, y)| x.is_finite() && y.is_finite())
-            .collect();
-        let clearance = self.clearance_um();
-
-        let caption = "Rotor-centre path relative to the race";
-        let rest = with_header(area, 34, caption, CAPTION_FONT)?;
-        let (legend_band, plot_area) = rest.split_vertically(26);
-        let mut legend = vec![(LegendMark::Line(PATH_COLOUR), "path".to_string())];
-        if !path.is_empty() {
-            legend.push((LegendMark::Dot(START_COLOUR), "release".to_string()));
-            legend.push((LegendMark::Dot(END_COLOUR), "end".to_string()));
-        }
-        if let Some(c) = clearance {
-            let text = format!("clearance circle, r = {} µm", format_quantity(c));
-            legend.push((LegendMark::Dashed(CLEARANCE_COLOUR), text));
-        }
-        let legend: Vec<(LegendMark, &str)> =
-            legend.iter().map(|(m, t)| (*m, t.as_str())).collect();
-        draw_legend_row(&legend_band, &legend)?;
-
-        orbit_panel(
-            &plot_area,
-            &path,
-            clearance,
-            (X_LABEL_AREA, Y_LABEL_AREA),
-            9,
-        )
-    }
-
-    /// Bottom panel: contact force against time.
-    fn draw_force_panel<DB: DrawingBackend>(
-        &self,
-        area: &DrawingArea<DB, Shift>,
-    ) -> DrawResult<DB> {
-        let points: Vec<(f64, f64)> = self
-            .samples
-            .iter()
-            .map(|s| (s.t_s * 1e3, s.contact_force_n))
-            .filter(|(t, f)| t.is_finite() && f.is_finite())
-            .collect();
-        let peak = points
-            .iter()
-            .copied()
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .filter(|p| p.1 > 0.0);
-        let caption = match peak {
-            Some((t, f)) => format!(
-                "Rotor-race contact force (peak {} N at {} ms)",
-                format_quantity(f),
-                format_quantity(t)
-            ),
-            None => "Rotor-race contact force".to_string(),
-        };
-        let plot_area = with_header(area, 34, &caption, CAPTION_FONT)?;
-
-        let t_range = padded_range(finite_bounds(points.iter().map(|p| p.0)), 0.0);
-        let f_bounds = finite_bounds(points.iter().map(|p| p.1));
-        let f_range = match f_bounds {
-            Some((lo, hi)) if hi > 0.0 => (lo.min(0.0), hi + (hi - lo.min(0.0)) * 0.06),
-            other => padded_range(other.map(|(lo, hi)| (lo.min(0.0), hi.max(0.0))), 0.06),
-        };
-        let mut chart = ChartBuilder::on(&plot_area)
-            .margin_top(8)
-            .margin_bottom(6)
-            .margin_left(20)
-            .margin_right(34)
-            .x_label_area_size(X_LABEL_AREA)
-            .y_label_area_size(Y_LABEL_AREA)
-            .build_cartesian_2d(t_range.0..t_range.1, f_range.0..f_range.1)?;
-        draw_mesh(&mut chart, "time (ms)", "contact force (N)", 10, 6)?;
-        if points.is_empty() {
-            let style = text_style(CAPTION_FONT).pos(Pos::new(HPos::Center, VPos::Center));
-            let (w, h) = chart.plotting_area().dim_in_pixel();
-            chart.plotting_area().strip_coord_spec().draw_text(
-                "no samples recorded",
-                &style,
-                (w as i32 / 2, h as i32 / 2),
-            )?;
-        } else {
-            draw_thin_line(&mut chart, &points, FORCE_COLOUR)?;
-        }
-        Ok(())
-    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -3,7 +3,7 @@
 //! the load share and an unbalance.
 //!
 //! ```text
-//! cargo run --release -p whirlmap-sweep --example physics [-- OUT]
+//! cargo run --release --example physics [-- OUT]
 //! ```
 //!
 //! writes `OUT` (default `results/physics`): `study.json` (every number), `summary.md` (the
@@ -33,12 +33,12 @@ use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 use whirlmap_core::orbit::OrbitSample;
 use whirlmap_core::{simulate, DropOptions, OrbitClass, Scene};
-use whirlmap_sweep::charts::{class_colour, legend, Mark};
-use whirlmap_sweep::critical::{critical_rows, CriticalOptions};
-use whirlmap_sweep::render::{
+use whirlmap_plot::marks::{class_colour, legend, Mark};
+use whirlmap_plot::render::{
     chart_header, chart_mesh, render, DrawResult, Figure, TITLE_BAND, TITLE_FONT, X_LABEL_AREA,
     Y_LABEL_AREA,
 };
+use whirlmap_sweep::critical::{critical_rows, CriticalOptions};
 
 /// The paper scene at a speed and friction coefficient.
 fn scene(speed_rpm: f64, mu: f64) -> Scene {
@@ -396,9 +396,7 @@ fn fmt_opt(v: Option<f64>, digits: usize) -> String {
 
 /// The tables the docs quote.
 fn summary(s: &Study) -> String {
-    let mut md = String::from(
-        "# Physics study (`cargo run --release -p whirlmap-sweep --example physics`)\n\n",
-    );
+    let mut md = String::from("# Physics study (`cargo run --release --example physics`)\n\n");
     md.push_str("## Mechanism: mu 0.35, paths against the 30 000 r/min path\n\n");
     md.push_str("| release speed (r/min) | race first rolls at (ms) | leaves the 30 000 r/min path at (ms, > 5 um) | class |\n|---|---|---|---|\n");
     for t in &s.slip_traces {
@@ -549,7 +547,7 @@ impl Figure for Mechanism<'_> {
             chart.draw_series([Text::new(
                 text,
                 (0.5, y + 4.0),
-                whirlmap_sweep::render::chart_text_style(13.0),
+                whirlmap_plot::render::chart_text_style(13.0),
             )])?;
         }
         let mut entries = Vec::new();
@@ -738,7 +736,7 @@ impl Figure for SensitivityFigure<'_> {
             chart.draw_series([Text::new(
                 "paper scene",
                 (paper, 0.395),
-                whirlmap_sweep::render::chart_text_style(13.0),
+                whirlmap_plot::render::chart_text_style(13.0),
             )])?;
             let pts: Vec<(f64, f64)> = rows
                 .iter()
@@ -775,7 +773,7 @@ impl Figure for SensitivityFigure<'_> {
                 .position(SeriesLabelPosition::UpperLeft)
                 .background_style(WHITE.mix(0.8))
                 .border_style(RGBColor(150, 150, 150))
-                .label_font(whirlmap_sweep::render::chart_text_style(14.0))
+                .label_font(whirlmap_plot::render::chart_text_style(14.0))
                 .draw()?;
         }
         Ok(())

@@ -5,8 +5,8 @@
 //! Groups are placed by their `mu` input; with further (non-speed) axes, all groups are
 //! drawn over each other.
 
-use crate::charts::{ChartError, CHART_SIZE};
-use crate::ensemble::{ContoursFile, CONTOURS_FILE};
+use crate::axes::CHART_SIZE;
+use crate::error::ChartError;
 use crate::render::{
     chart_header, chart_mesh, chart_text_style, render, DrawResult, Figure, TITLE_BAND, TITLE_FONT,
     X_LABEL_AREA, Y_LABEL_AREA,
@@ -14,6 +14,8 @@ use crate::render::{
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
+use whirlmap_results::contours::{ContourGroup, ContoursFile};
+use whirlmap_results::files::CONTOURS_FILE;
 
 const LEVEL_COLOURS: [RGBColor; 4] = [
     RGBColor(230, 145, 30),
@@ -37,7 +39,7 @@ fn mu_of(inputs: &std::collections::BTreeMap<String, f64>) -> Option<f64> {
 
 impl Figure for ProbabilityFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let mut groups: Vec<(f64, &crate::ensemble::ContourGroup)> = self
+        let mut groups: Vec<(f64, &ContourGroup)> = self
             .contours
             .groups
             .iter()

@@ -1,7 +1,6 @@
 //! The work-precision chart of `whirlmap accuracy`: error against cost, log-log, one panel per
 //! case and one line per setting (its tolerance ladder), drawn with the embedded font.
 
-use crate::accuracy::Study;
 use crate::render::{
     draw_legend_row, render, text_style, with_header, DrawResult, Figure, LegendMark, RenderError,
     AXIS_COLOUR, AXIS_DESC_FONT, CAPTION_FONT, GRID_BOLD, GRID_LIGHT, TICK_FONT, TITLE_BAND,
@@ -18,6 +17,32 @@ pub enum CostAxis {
     RhsEvals,
     /// Wall time in ms (this machine, noisy).
     WallMs,
+}
+
+/// One run of the study, as the chart takes it: the engine's rows reduced to plain values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyRun {
+    /// Case name.
+    pub case: String,
+    /// Setting name (`preset:standard` for the presets, which the chart leaves out).
+    pub setting: String,
+    /// Tolerance.
+    pub rtol: f64,
+    /// What the run cost and how far it was off; `None`: the run failed.
+    pub cost: Option<RunCost>,
+}
+
+/// The cost and error of one finished run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunCost {
+    /// RHS evaluations.
+    pub rhs_evals: u64,
+    /// Wall time (ms).
+    pub wall_ms: f64,
+    /// The largest relative error of the measured outputs (the y value).
+    pub worst_rel: f64,
+    /// Whether the orbit class agrees with the reference's.
+    pub class_agrees: bool,
 }
 
 /// Errors below this are drawn at it (the reference's own floor is far above).
@@ -57,32 +82,30 @@ fn colour(i: usize) -> RGBColor {
     P[i % P.len()]
 }
 
-fn build(study: &Study, axis: CostAxis, title: &str) -> WorkPrecision {
+fn build(cases: &[String], runs: &[StudyRun], axis: CostAxis, title: &str) -> WorkPrecision {
     let mut settings: Vec<String> = Vec::new();
-    for r in &study.rows {
+    for r in runs {
         if !r.setting.starts_with("preset:") && !settings.contains(&r.setting) {
             settings.push(r.setting.clone());
         }
     }
-    let panels = study
-        .references
+    let panels = cases
         .iter()
-        .map(|reference| Panel {
-            case: reference.case.clone(),
+        .map(|case| Panel {
+            case: case.clone(),
             lines: settings
                 .iter()
                 .map(|s| {
-                    let mut points: Vec<(f64, f64, f64, bool)> = study
-                        .rows
+                    let mut points: Vec<(f64, f64, f64, bool)> = runs
                         .iter()
-                        .filter(|r| r.case == reference.case && &r.setting == s)
-                        .filter_map(|r| r.result.as_ref().ok().map(|(m, e)| (r.rtol, m, e)))
-                        .map(|(rtol, m, e)| {
+                        .filter(|r| &r.case == case && &r.setting == s)
+                        .filter_map(|r| r.cost.map(|c| (r.rtol, c)))
+                        .map(|(rtol, c)| {
                             let cost = match axis {
-                                CostAxis::RhsEvals => m.rhs_evals as f64,
-                                CostAxis::WallMs => m.wall_ms,
+                                CostAxis::RhsEvals => c.rhs_evals as f64,
+                                CostAxis::WallMs => c.wall_ms,
                             };
-                            (rtol, cost, e.worst_rel().max(ERR_FLOOR), e.class_agrees)
+                            (rtol, cost, c.worst_rel.max(ERR_FLOOR), c.class_agrees)
                         })
                         .filter(|p| p.1 > 0.0 && p.1.is_finite() && p.2.is_finite())
                         .collect();
@@ -218,14 +241,16 @@ impl Figure for WorkPrecision {
     }
 }
 
-/// Writes the work-precision chart of `study` against `axis` to `path` (`.png` or `.svg`).
+/// Writes the work-precision chart of the study's `runs` against `axis` to `path` (`.png` or
+/// `.svg`): one panel per entry of `cases`, in that order.
 pub fn draw_work_precision(
     path: &Path,
-    study: &Study,
+    cases: &[String],
+    runs: &[StudyRun],
     axis: CostAxis,
     title: &str,
 ) -> Result<(), RenderError> {
-    let fig = build(study, axis, title);
+    let fig = build(cases, runs, axis, title);
     let rows = fig.panels.len().div_ceil(3).max(1) as u32;
     render(path, (1500, 80 + 70 + 420 * rows), &fig)
 }

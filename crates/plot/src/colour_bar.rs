@@ -1,0 +1,65 @@
+//! The colour scale of the heat maps and its bar.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::ViridisRGB;
+
+use crate::marks::CONTOUR;
+use crate::render::{
+    chart_text_style, chart_tick_formatter, DrawResult, AXIS_DESC_FONT, TICK_FONT, X_LABEL_AREA,
+};
+
+/// The colour-scale colour of `v` in `lo..hi` (ends for anything outside, mid for NaN).
+pub(crate) fn scale_colour(v: f64, lo: f64, hi: f64) -> RGBColor {
+    let t = (v - lo) / (hi - lo);
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    ViridisRGB::get_color_normalized(t, 0.0, 1.0)
+}
+
+pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    lo: f64,
+    hi: f64,
+    levels: &[f64],
+    label: &str,
+) -> DrawResult<DB> {
+    let mut bar = ChartBuilder::on(area)
+        .margin_top(12)
+        .margin_bottom(4 + X_LABEL_AREA)
+        .margin_left(8)
+        .margin_right(4)
+        .right_y_label_area_size(96)
+        .build_cartesian_2d(0.0..1.0, lo..hi)?;
+    let fmt = chart_tick_formatter(hi - lo);
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(8)
+        .y_label_formatter(&fmt)
+        .y_desc(label)
+        .label_style(chart_text_style(TICK_FONT))
+        .axis_desc_style(chart_text_style(AXIS_DESC_FONT))
+        .axis_style(RGBColor(90, 90, 90).stroke_width(1))
+        .draw()?;
+    const STEPS: usize = 128;
+    bar.draw_series((0..STEPS).map(|k| {
+        let a = lo + (hi - lo) * k as f64 / STEPS as f64;
+        let b = lo + (hi - lo) * (k + 1) as f64 / STEPS as f64;
+        let c = scale_colour((a + b) / 2.0, lo, hi);
+        Rectangle::new([(0.0, a), (1.0, b)], c.filled())
+    }))?;
+    bar.draw_series(
+        levels
+            .iter()
+            .map(|&l| PathElement::new(vec![(0.0, l), (1.0, l)], CONTOUR.stroke_width(2))),
+    )?;
+    bar.draw_series([Rectangle::new(
+        [(0.0, lo), (1.0, hi)],
+        RGBColor(90, 90, 90).stroke_width(1),
+    )])?;
+    Ok(())
+}

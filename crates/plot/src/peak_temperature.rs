@@ -1,0 +1,16 @@
+//! The hottest node's peak temperature over release speed and friction (records made with
+//! the thermal model only).
+
+use whirlmap_results::grid::Grid;
+
+use crate::heatmap::{with_slice, GridFigure, GridMode};
+
+/// The figure of `grid` (`charts/peak_temperature`).
+pub(crate) fn figure(grid: &Grid) -> GridFigure<'_> {
+    GridFigure {
+        grid,
+        title: with_slice("Peak touchdown-bearing temperature", &grid.slice),
+        mode: GridMode::Metric(|r| r.peak_temperature_k),
+        bar_label: "hottest node peak temperature (K)",
+    }
+}

@@ -1,0 +1,138 @@
+//! Every chart of a results folder, drawn into its `charts/` folder.
+
+use std::path::{Path, PathBuf};
+
+use whirlmap_results::files::CHARTS_DIR;
+use whirlmap_results::files::POINTS_FILE;
+use whirlmap_results::grid::{assemble_grid, distinct_sorted};
+
+use crate::axes::CHART_SIZE;
+use crate::error::ChartError;
+use crate::fig3_orbits::{orbit_figure_size, OrbitPanels};
+use crate::fig4::{band_points, Fig4};
+use crate::load::{load_critical, load_orbits, load_points, load_probability};
+use crate::render::{chart_quantity, render, Figure};
+
+pub(crate) fn write_both<F: Figure>(
+    out_dir: &Path,
+    stem: &str,
+    size: (u32, u32),
+    figure: &F,
+    written: &mut Vec<PathBuf>,
+) -> Result<(), ChartError> {
+    for ext in ["png", "svg"] {
+        let path = out_dir.join(format!("{stem}.{ext}"));
+        render(&path, size, figure)?;
+        written.push(path);
+    }
+    Ok(())
+}
+
+/// Draws every chart whose data exists in the results directory `dir` into `dir/charts/`, as
+/// PNG and SVG: `fig5_max_force`, `fig6_peak_power` and `classes` from `points.jsonl`
+/// (required), `peak_temperature` if the records carry temperatures, `fig4_critical` if
+/// `critical.json` exists, `fig3_orbits` if `orbits/` holds orbit files, `fig4_probability` if
+/// `contours.json` (an ensemble's) exists (then `points.jsonl` is optional). Returns the paths
+/// written.
+pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
+    // An ensemble's results: Fig. 4 with probability bands (docs/probability.md).
+    let prob = crate::probability::render_probability(dir)?;
+    if !prob.is_empty() && !dir.join(POINTS_FILE).exists() {
+        return Ok(prob);
+    }
+    let rows = load_points(dir)?;
+    let critical = load_critical(dir)?;
+    let orbits = load_orbits(dir)?;
+    let grid = assemble_grid(&rows);
+
+    let out_dir = dir.join(CHARTS_DIR);
+    std::fs::create_dir_all(&out_dir).map_err(|cause| ChartError::Write {
+        path: out_dir.clone(),
+        cause,
+    })?;
+    let mut written = Vec::new();
+    let fig5 = crate::fig5::figure(&grid);
+    write_both(&out_dir, "fig5_max_force", CHART_SIZE, &fig5, &mut written)?;
+    let fig6 = crate::fig6::figure(&grid);
+    write_both(&out_dir, "fig6_peak_power", CHART_SIZE, &fig6, &mut written)?;
+    let classes = crate::classes::figure(&grid);
+    write_both(&out_dir, "classes", CHART_SIZE, &classes, &mut written)?;
+    if rows.iter().any(|r| r.peak_temperature_k.is_some()) {
+        // Only records made with the thermal model carry temperatures.
+        let temps = crate::peak_temperature::figure(&grid);
+        write_both(
+            &out_dir,
+            "peak_temperature",
+            CHART_SIZE,
+            &temps,
+            &mut written,
+        )?;
+    }
+    if let Some(rows) = &critical {
+        let probability = load_probability(dir)?;
+        let band = probability.as_ref().map(band_points);
+        let label = probability.as_ref().map(|c| {
+            let top = c
+                .groups
+                .iter()
+                .filter_map(|g| g.speeds_rpm.last().copied())
+                .fold(0.0, f64::max);
+            format!(
+                "over release conditions ({} drops per cell, up to {} r/min)",
+                c.members,
+                chart_quantity(top)
+            )
+        });
+        let fig4 = Fig4 {
+            rows,
+            band: band.as_deref().zip(label),
+            title: "Fig. 4: critical speed of backward whirl".to_string(),
+        };
+        write_both(&out_dir, "fig4_critical", CHART_SIZE, &fig4, &mut written)?;
+    }
+    if !orbits.is_empty() {
+        let speeds = distinct_sorted(orbits.iter().map(|o| o.speed_rpm));
+        let title = match speeds.as_slice() {
+            [s] => format!(
+                "Fig. 3: orbits relative to the race at {} r/min",
+                chart_quantity(*s)
+            ),
+            _ => "Fig. 3: orbits relative to the race".to_string(),
+        };
+        let fig3 = OrbitPanels {
+            orbits: &orbits,
+            title,
+        };
+        write_both(
+            &out_dir,
+            "fig3_orbits",
+            orbit_figure_size(orbits.len()),
+            &fig3,
+            &mut written,
+        )?;
+    }
+    written.extend(prob);
+    remove_stale_charts(&out_dir, &written)?;
+    Ok(written)
+}
+
+/// Removes the charts in `dir` that this rendering did not draw (a Fig. 4 left from an
+/// earlier spec with a critical search, say), so `charts/` shows only what the data holds.
+pub(crate) fn remove_stale_charts(dir: &Path, written: &[PathBuf]) -> Result<(), ChartError> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        let chart = p
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("png") || x.eq_ignore_ascii_case("svg"));
+        if chart && p.is_file() && !written.iter().any(|w| w == &p) {
+            std::fs::remove_file(&p).map_err(|cause| ChartError::Write {
+                path: p.clone(),
+                cause,
+            })?;
+        }
+    }
+    Ok(())
+}
