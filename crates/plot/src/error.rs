@@ -9,30 +9,10 @@ use crate::render::RenderError;
 /// Why charts could not be drawn.
 #[derive(Debug, thiserror::Error)]
 pub enum ChartError {
-    /// The results directory has no `points.jsonl`.
-    #[error("no sweep results: {} does not exist", path.display())]
-    NoPoints {
-        /// The missing file.
-        path: PathBuf,
-    },
-    /// An input file could not be read.
-    #[error("cannot read {}: {cause}", path.display())]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        cause: std::io::Error,
-    },
-    /// An input file is not what it should be (a torn last line of points.jsonl is not).
-    #[error("{}: line {line}: {message}", path.display())]
-    Parse {
-        /// The file.
-        path: PathBuf,
-        /// 1-based line number (1 for whole-file JSON).
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
+    /// Missing or bad input (no `points.jsonl`, an unreadable or malformed file), in the
+    /// words of the results layer.
+    #[error(transparent)]
+    Load(#[from] LoadError),
     /// The charts directory could not be created.
     #[error("cannot create {}: {cause}", path.display())]
     Write {
@@ -50,24 +30,6 @@ impl ChartError {
     /// Whether this is a failure to write output (as opposed to missing or bad input).
     pub fn is_output(&self) -> bool {
         matches!(self, ChartError::Write { .. } | ChartError::Render(_))
-    }
-}
-
-impl From<LoadError> for ChartError {
-    fn from(e: LoadError) -> Self {
-        match e {
-            LoadError::NoPoints { path } => ChartError::NoPoints { path },
-            LoadError::Read { path, cause } => ChartError::Read { path, cause },
-            LoadError::Parse {
-                path,
-                line,
-                message,
-            } => ChartError::Parse {
-                path,
-                line,
-                message,
-            },
-        }
     }
 }
 

@@ -16,6 +16,7 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 use whirlmap_results::contours::{ContourGroup, ContoursFile};
 use whirlmap_results::files::CONTOURS_FILE;
+use whirlmap_results::read::LoadError;
 
 const LEVEL_COLOURS: [RGBColor; 4] = [
     RGBColor(230, 145, 30),
@@ -190,9 +191,9 @@ pub fn render_probability(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
     let text = match std::fs::read_to_string(&path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(cause) => return Err(ChartError::Read { path, cause }),
+        Err(cause) => return Err(LoadError::Read { path, cause }.into()),
     };
-    let contours: ContoursFile = serde_json::from_str(&text).map_err(|e| ChartError::Parse {
+    let contours: ContoursFile = serde_json::from_str(&text).map_err(|e| LoadError::Parse {
         path: path.clone(),
         line: e.line(),
         message: e.to_string(),

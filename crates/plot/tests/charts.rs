@@ -8,6 +8,7 @@ use whirlmap_core::MODEL_VERSION;
 use whirlmap_plot::{load_points, render_all, ChartError};
 use whirlmap_results::critical::{CriticalRow, Probe};
 use whirlmap_results::point::PointStatus;
+use whirlmap_results::read::LoadError;
 
 const SPEEDS: [f64; 6] = [2000.0, 4000.0, 6000.0, 8000.0, 10000.0, 12000.0];
 const MUS: [f64; 5] = [0.05, 0.1, 0.15, 0.2, 0.3];
@@ -166,12 +167,12 @@ fn torn_last_line_is_skipped() {
     std::fs::write(dir.join("points.jsonl"), lines.join("\n")).unwrap();
     assert!(matches!(
         load_points(&dir),
-        Err(ChartError::Parse { line: 4, .. })
+        Err(ChartError::Load(LoadError::Parse { line: 4, .. }))
     ));
     let missing = temp_dir("missing");
     assert!(matches!(
         load_points(&missing),
-        Err(ChartError::NoPoints { .. })
+        Err(ChartError::Load(LoadError::NoPoints { .. }))
     ));
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&missing);
