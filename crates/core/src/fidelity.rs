@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
     /// Screening: ROS34PW2 (linearly implicit, L-stable) with the free-flight gap bound and
-    /// the race's absolute tolerances x1000, at rtol 1e-4. About ten times cheaper than
+    /// the race's absolute tolerances x1000, at rtol 1e-4. About eight times cheaper than
     /// `standard`, but outside the accuracy budget: on bouncing sequences its maximum force
     /// is off by up to 12 % (docs/accuracy.md#fidelity-presets).
     Draft,
