@@ -35,7 +35,7 @@ use whirlmap_core::orbit::OrbitSample;
 use whirlmap_core::{simulate, DropOptions, OrbitClass, Scene};
 use whirlmap_plot::marks::{class_colour, legend, Mark};
 use whirlmap_plot::render::{
-    chart_header, chart_mesh, render, DrawResult, Figure, TITLE_BAND, TITLE_FONT, X_LABEL_AREA,
+    draw_mesh, render, with_header, DrawResult, Figure, TITLE_BAND, TITLE_FONT, X_LABEL_AREA,
     Y_LABEL_AREA,
 };
 use whirlmap_sweep::critical::{critical_rows, CriticalOptions};
@@ -511,7 +511,7 @@ struct Mechanism<'a>(&'a Study);
 
 impl Figure for Mechanism<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let body = chart_header(
+        let body = with_header(
             root,
             TITLE_BAND,
             "What decides whirl: the symmetric release while the race slips",
@@ -527,7 +527,7 @@ impl Figure for Mechanism<'_> {
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(0.0..T_END, a_lo..a_hi)?;
-        chart_mesh(
+        draw_mesh(
             &mut chart,
             "time after release (ms), 16 000 r/min",
             "contact angle from the bottom (deg)",
@@ -547,7 +547,7 @@ impl Figure for Mechanism<'_> {
             chart.draw_series([Text::new(
                 text,
                 (0.5, y + 4.0),
-                whirlmap_plot::render::chart_text_style(13.0),
+                whirlmap_plot::render::text_style(13.0),
             )])?;
         }
         let mut entries = Vec::new();
@@ -599,7 +599,7 @@ impl Figure for Mechanism<'_> {
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(0.0..T_END, -1.0..slip_top)?;
-        chart_mesh(
+        draw_mesh(
             &mut chart,
             "time after release (ms), mu 0.35",
             "slip velocity at the contact (m/s)",
@@ -640,7 +640,7 @@ struct ThresholdMap<'a>(&'a Study);
 impl Figure for ThresholdMap<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
         let s = self.0;
-        let body = chart_header(
+        let body = with_header(
             root,
             TITLE_BAND,
             "Orbit class over friction and speed, symmetric release",
@@ -664,7 +664,7 @@ impl Figure for ThresholdMap<'_> {
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(m0..m1, v0..v1)?;
-        chart_mesh(
+        draw_mesh(
             &mut chart,
             "friction coefficient µ (-)",
             "release speed (r/min)",
@@ -696,7 +696,7 @@ struct SensitivityFigure<'a>(&'a Study);
 
 impl Figure for SensitivityFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let body = chart_header(
+        let body = with_header(
             root,
             TITLE_BAND,
             "Friction threshold and onset speed against support damping and load share",
@@ -725,7 +725,7 @@ impl Figure for SensitivityFigure<'_> {
                 .x_label_area_size(X_LABEL_AREA)
                 .y_label_area_size(Y_LABEL_AREA)
                 .build_cartesian_2d((x0 - pad)..(x1 + pad), 0.25..0.40)?;
-            chart_mesh(&mut chart, desc, "friction threshold µ (-)", 6, 6)?;
+            draw_mesh(&mut chart, desc, "friction threshold µ (-)", 6, 6)?;
             let paper = if *name == "load_share" { 0.5 } else { 750.0 };
             chart.draw_series([DashedPathElement::new(
                 vec![(paper, 0.25), (paper, 0.40)],
@@ -736,7 +736,7 @@ impl Figure for SensitivityFigure<'_> {
             chart.draw_series([Text::new(
                 "paper scene",
                 (paper, 0.395),
-                whirlmap_plot::render::chart_text_style(13.0),
+                whirlmap_plot::render::text_style(13.0),
             )])?;
             let pts: Vec<(f64, f64)> = rows
                 .iter()
@@ -750,7 +750,7 @@ impl Figure for SensitivityFigure<'_> {
                 .x_label_area_size(X_LABEL_AREA)
                 .y_label_area_size(Y_LABEL_AREA)
                 .build_cartesian_2d((x0 - pad)..(x1 + pad), 0.0..8000.0)?;
-            chart_mesh(&mut chart, desc, "onset speed (r/min)", 6, 8)?;
+            draw_mesh(&mut chart, desc, "onset speed (r/min)", 6, 8)?;
             for (k, mu) in [0.35, 0.4, 0.5].into_iter().enumerate() {
                 let pts: Vec<(f64, f64)> = rows
                     .iter()
@@ -773,7 +773,7 @@ impl Figure for SensitivityFigure<'_> {
                 .position(SeriesLabelPosition::UpperLeft)
                 .background_style(WHITE.mix(0.8))
                 .border_style(RGBColor(150, 150, 150))
-                .label_font(whirlmap_plot::render::chart_text_style(14.0))
+                .label_font(whirlmap_plot::render::text_style(14.0))
                 .draw()?;
         }
         Ok(())
@@ -784,7 +784,7 @@ struct UnbalanceFigure<'a>(&'a Study);
 
 impl Figure for UnbalanceFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let body = chart_header(
+        let body = with_header(
             root,
             TITLE_BAND,
             "Share of 16 unbalance phases that whirl at 8 000 r/min",
@@ -796,7 +796,7 @@ impl Figure for UnbalanceFigure<'_> {
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(0.24..0.36, -0.02..1.02)?;
-        chart_mesh(
+        draw_mesh(
             &mut chart,
             "friction coefficient µ (-)",
             "share whirling (-)",

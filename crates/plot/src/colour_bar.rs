@@ -6,7 +6,7 @@ use plotters::style::colors::colormaps::ViridisRGB;
 
 use crate::marks::CONTOUR;
 use crate::render::{
-    chart_text_style, chart_tick_formatter, DrawResult, AXIS_DESC_FONT, TICK_FONT, X_LABEL_AREA,
+    text_style, tick_formatter, DrawResult, AXIS_DESC_FONT, TICK_FONT, X_LABEL_AREA,
 };
 
 /// The colour-scale colour of `v` in `lo..hi` (ends for anything outside, mid for NaN).
@@ -34,15 +34,15 @@ pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
         .margin_right(4)
         .right_y_label_area_size(96)
         .build_cartesian_2d(0.0..1.0, lo..hi)?;
-    let fmt = chart_tick_formatter(hi - lo);
+    let fmt = tick_formatter(hi - lo);
     bar.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
         .y_labels(8)
         .y_label_formatter(&fmt)
         .y_desc(label)
-        .label_style(chart_text_style(TICK_FONT))
-        .axis_desc_style(chart_text_style(AXIS_DESC_FONT))
+        .label_style(text_style(TICK_FONT))
+        .axis_desc_style(text_style(AXIS_DESC_FONT))
         .axis_style(RGBColor(90, 90, 90).stroke_width(1))
         .draw()?;
     const STEPS: usize = 128;

@@ -7,7 +7,7 @@ use whirlmap_results::orbit::OrbitFile;
 
 use crate::marks::{legend, Mark};
 use crate::render::{
-    chart_header, chart_quantity, decimate_samples, orbit_panel, DrawResult, Figure, CAPTION_FONT,
+    decimate_samples, format_quantity, orbit_panel, with_header, DrawResult, Figure, CAPTION_FONT,
     CLEARANCE_COLOUR, PATH_COLOUR, TITLE_BAND, TITLE_FONT,
 };
 
@@ -38,7 +38,7 @@ pub(crate) fn orbit_figure_size(n: usize) -> (u32, u32) {
 
 impl Figure for OrbitPanels<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
+        let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (_, bh) = body.dim_in_pixel();
         let (panels_area, legend_band) = body.split_vertically(bh.saturating_sub(44));
         let (cols, rows) = panel_layout(self.orbits.len());
@@ -46,11 +46,11 @@ impl Figure for OrbitPanels<'_> {
         for (o, area) in self.orbits.iter().zip(panels.iter()) {
             let caption = format!(
                 "µ = {}, {} r/min: {}",
-                chart_quantity(o.mu),
-                chart_quantity(o.speed_rpm),
+                format_quantity(o.mu),
+                format_quantity(o.speed_rpm),
                 o.class_label()
             );
-            let plot = chart_header(area, 34, &caption, CAPTION_FONT)?;
+            let plot = with_header(area, 34, &caption, CAPTION_FONT)?;
             let samples = decimate_samples(&o.orbit.samples, 8_000);
             let path: Vec<(f64, f64)> = samples
                 .iter()

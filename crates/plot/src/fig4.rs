@@ -28,7 +28,7 @@ use whirlmap_results::grid::clamp_value;
 use crate::axes::MU_DESC;
 use crate::marks::{arrow, legend, triangle_up, Mark, BAND};
 use crate::render::{
-    chart_header, chart_mesh, chart_quantity, chart_text_style, DrawResult, Figure, TITLE_BAND,
+    draw_mesh, format_quantity, text_style, with_header, DrawResult, Figure, TITLE_BAND,
     TITLE_FONT, X_LABEL_AREA, Y_LABEL_AREA,
 };
 
@@ -120,7 +120,7 @@ impl Figure for Fig4<'_> {
             .max(1.0);
         let y1 = top * 1.12;
 
-        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
+        let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (_, bh) = body.dim_in_pixel();
         let (plot_area, legend_band) = body.split_vertically(bh.saturating_sub(64));
         let mut chart = ChartBuilder::on(&plot_area)
@@ -131,7 +131,7 @@ impl Figure for Fig4<'_> {
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(x0..x1, 0.0..y1)?;
-        chart_mesh(&mut chart, MU_DESC, "release speed (r/min)", 10, 8)?;
+        draw_mesh(&mut chart, MU_DESC, "release speed (r/min)", 10, 8)?;
 
         // The probability band first, under everything else.
         if band.len() >= 2 {
@@ -244,8 +244,8 @@ impl Figure for Fig4<'_> {
                 NONE_MARK.mix(0.6).stroke_width(1),
             ))?;
             canvas.draw_text(
-                &format!("top of the searched range, {} r/min", chart_quantity(t)),
-                &chart_text_style(13.0)
+                &format!("top of the searched range, {} r/min", format_quantity(t)),
+                &text_style(13.0)
                     .color(&NONE_MARK)
                     .pos(Pos::new(HPos::Left, VPos::Bottom)),
                 (a.0 + 6, a.1 - 12),

@@ -14,7 +14,7 @@ use crate::marks::{
     boxed_text, class_colour, cross, hatch, legend, Mark, ALL_CLASSES, CONTOUR, FAILED_BG, WHIRL_BG,
 };
 use crate::render::{
-    chart_header, chart_mesh, chart_quantity, DrawResult, Figure, CAPTION_FONT, TITLE_BAND,
+    draw_mesh, format_quantity, with_header, DrawResult, Figure, CAPTION_FONT, TITLE_BAND,
     TITLE_FONT, X_LABEL_AREA, Y_LABEL_AREA,
 };
 use whirlmap_results::point::PointStatus;
@@ -127,7 +127,7 @@ impl Figure for GridFigure<'_> {
         });
         let is_metric = matches!(self.mode, GridMode::Metric(_));
 
-        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
+        let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (bw, bh) = body.dim_in_pixel();
         let (main, legend_band) = body.split_vertically(bh.saturating_sub(44));
         let (plot_area, bar_area) = if is_metric {
@@ -144,7 +144,7 @@ impl Figure for GridFigure<'_> {
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(xe[0]..xe[xe.len() - 1], ye[0]..ye[ye.len() - 1])?;
-        chart_mesh(&mut chart, SPEED_DESC, MU_DESC, 10, 8)?;
+        draw_mesh(&mut chart, SPEED_DESC, MU_DESC, 10, 8)?;
 
         let pa = chart.plotting_area();
         let base = pa.get_base_pixel();
@@ -239,7 +239,7 @@ impl Figure for GridFigure<'_> {
                     let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
                     boxed_text(
                         &canvas,
-                        &chart_quantity(level),
+                        &format_quantity(level),
                         ((p.0 + q.0) / 2, (p.1 + q.1) / 2),
                         13.0,
                         CONTOUR,

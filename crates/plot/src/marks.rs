@@ -7,7 +7,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use whirlmap_core::classify::OrbitClass;
 
-use crate::render::{chart_text_style, DrawResult, TICK_FONT};
+use crate::render::{text_style, DrawResult, TICK_FONT};
 
 pub(crate) const WHITE_TEXT_BG: RGBColor = RGBColor(255, 255, 255);
 pub(crate) const WHIRL_BG: RGBColor = RGBColor(236, 236, 236);
@@ -147,7 +147,7 @@ pub fn legend<DB: DrawingBackend>(
     const MARK_W: i32 = 26;
     const GAP: i32 = 7;
     const ENTRY_GAP: i32 = 26;
-    let style = chart_text_style(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center));
+    let style = text_style(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center));
     let mut widths = Vec::new();
     for (_, label) in entries {
         widths.push(MARK_W + GAP + area.estimate_text_size(label, &style)?.0 as i32);
@@ -252,7 +252,7 @@ pub(crate) fn boxed_text<DB: DrawingBackend>(
     size: f64,
     colour: RGBColor,
 ) -> DrawResult<DB> {
-    let style = chart_text_style(size)
+    let style = text_style(size)
         .color(&colour)
         .pos(Pos::new(HPos::Center, VPos::Center));
     let (w, h) = area.estimate_text_size(text, &style)?;

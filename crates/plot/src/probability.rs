@@ -8,7 +8,7 @@
 use crate::axes::CHART_SIZE;
 use crate::error::ChartError;
 use crate::render::{
-    chart_header, chart_mesh, chart_text_style, render, DrawResult, Figure, TITLE_BAND, TITLE_FONT,
+    draw_mesh, render, text_style, with_header, DrawResult, Figure, TITLE_BAND, TITLE_FONT,
     X_LABEL_AREA, Y_LABEL_AREA,
 };
 use plotters::coord::Shift;
@@ -68,7 +68,7 @@ impl Figure for ProbabilityFigure<'_> {
         let (m_lo, m_hi) = span(&mus);
         let (pad_m, pad_s) = (0.08 * (m_hi - m_lo), 0.05 * (s_hi - s_lo));
 
-        let body = chart_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
+        let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (_, bh) = body.dim_in_pixel();
         let (plot_area, legend_band) = body.split_vertically(bh.saturating_sub(50));
         let mut chart = ChartBuilder::on(&plot_area)
@@ -82,7 +82,7 @@ impl Figure for ProbabilityFigure<'_> {
                 (m_lo - pad_m)..(m_hi + pad_m),
                 (s_lo - pad_s)..(s_hi + pad_s),
             )?;
-        chart_mesh(
+        draw_mesh(
             &mut chart,
             "friction coefficient µ (-)",
             "release speed (r/min)",
@@ -154,7 +154,7 @@ impl Figure for ProbabilityFigure<'_> {
         }
 
         // Legend: one entry per level.
-        let style = chart_text_style(14.0);
+        let style = text_style(14.0);
         let mut x = 60;
         for (k, l) in self
             .contours

@@ -262,12 +262,13 @@ pub(crate) const CLEARANCE_COLOUR: RGBColor = RGBColor(120, 120, 120);
 pub(crate) const START_COLOUR: RGBColor = RGBColor(44, 160, 44);
 pub(crate) const END_COLOUR: RGBColor = RGBColor(214, 39, 40);
 
-pub(crate) fn text_style(size: f64) -> TextStyle<'static> {
+/// The embedded-font text style of `size` px in the chart text colour.
+pub fn text_style(size: f64) -> TextStyle<'static> {
     TextStyle::from((FONT_FAMILY, size).into_font()).color(&TEXT_COLOUR)
 }
 
 /// Draws `text` centred in `area`, shrinking the font (down to 12 px) so it fits the width.
-pub(crate) fn draw_centered_text<DB: DrawingBackend>(
+pub fn draw_centered_text<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     text: &str,
     size: f64,
@@ -285,7 +286,7 @@ pub(crate) fn draw_centered_text<DB: DrawingBackend>(
 
 /// Splits off a band of `height` px at the top of `area` with `text` centred in it; returns
 /// the rest.
-pub(crate) fn with_header<DB: DrawingBackend>(
+pub fn with_header<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     height: u32,
     text: &str,
@@ -347,7 +348,7 @@ pub(crate) fn draw_legend_row<DB: DrawingBackend>(
 
 /// A tick-label formatter for an axis spanning `span`: enough decimals for the tick step,
 /// trailing zeros trimmed, scientific notation for very large or small values.
-pub(crate) fn tick_formatter(span: f64) -> impl Fn(&f64) -> String {
+pub fn tick_formatter(span: f64) -> impl Fn(&f64) -> String {
     let span = if span.is_finite() && span > 0.0 {
         span
     } else {
@@ -368,7 +369,7 @@ pub(crate) fn tick_formatter(span: f64) -> impl Fn(&f64) -> String {
 }
 
 /// `"2.50"` to `"2.5"`, `"3.00"` to `"3"`; integers unchanged.
-pub(crate) fn trim_decimal_zeros(s: &str) -> &str {
+pub fn trim_decimal_zeros(s: &str) -> &str {
     if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.')
     } else {
@@ -377,7 +378,7 @@ pub(crate) fn trim_decimal_zeros(s: &str) -> &str {
 }
 
 /// `value` with about three significant digits, for captions.
-pub(crate) fn format_quantity(value: f64) -> String {
+pub fn format_quantity(value: f64) -> String {
     let a = value.abs();
     if !value.is_finite() {
         "n/a".to_string()
@@ -424,7 +425,7 @@ pub(crate) fn padded_range(bounds: Option<(f64, f64)>, pad: f64) -> (f64, f64) {
 }
 
 /// Applies the common axis styling (fonts, grid, units, tick formats) to `chart`'s mesh.
-pub(crate) fn draw_mesh<DB: DrawingBackend>(
+pub fn draw_mesh<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     x_desc: &str,
     y_desc: &str,
@@ -472,46 +473,6 @@ pub(crate) fn draw_thin_line<DB: DrawingBackend>(
         chart.draw_series(points.iter().map(|&p| Pixel::new(p, colour)))?;
     }
     Ok(())
-}
-
-// ---------------------------------------------------------------------------------------------
-// The shared styling helpers, for the design charts (`crate::charts`) and for studies that
-// draw their own figures (the examples).
-
-/// The embedded-font text style of `size` px in the chart text colour.
-pub fn chart_text_style(size: f64) -> TextStyle<'static> {
-    text_style(size)
-}
-
-/// Splits a titled band off the top of `area` (see `with_header`); returns the rest.
-pub fn chart_header<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    height: u32,
-    text: &str,
-    size: f64,
-) -> Result<DrawingArea<DB, Shift>, DrawingAreaErrorKind<DB::ErrorType>> {
-    with_header(area, height, text, size)
-}
-
-/// The common axis styling (see `draw_mesh`).
-pub fn chart_mesh<DB: DrawingBackend>(
-    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
-    x_desc: &str,
-    y_desc: &str,
-    x_ticks: usize,
-    y_ticks: usize,
-) -> DrawResult<DB> {
-    draw_mesh(chart, x_desc, y_desc, x_ticks, y_ticks)
-}
-
-/// A short tick-label formatter for an axis spanning `span` (see `tick_formatter`).
-pub fn chart_tick_formatter(span: f64) -> impl Fn(&f64) -> String {
-    tick_formatter(span)
-}
-
-/// `value` with about three significant digits (see `format_quantity`).
-pub fn chart_quantity(value: f64) -> String {
-    format_quantity(value)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use crate::error::ChartError;
 use crate::fig3_orbits::{orbit_figure_size, OrbitPanels};
 use crate::fig4::{band_points, Fig4};
 use crate::load::{load_critical, load_orbits, load_points, load_probability};
-use crate::render::{chart_quantity, render, Figure};
+use crate::render::{format_quantity, render, Figure};
 
 pub(crate) fn write_both<F: Figure>(
     out_dir: &Path,
@@ -80,7 +80,7 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
             format!(
                 "over release conditions ({} drops per cell, up to {} r/min)",
                 c.members,
-                chart_quantity(top)
+                format_quantity(top)
             )
         });
         let fig4 = Fig4 {
@@ -95,7 +95,7 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         let title = match speeds.as_slice() {
             [s] => format!(
                 "Fig. 3: orbits relative to the race at {} r/min",
-                chart_quantity(*s)
+                format_quantity(*s)
             ),
             _ => "Fig. 3: orbits relative to the race".to_string(),
         };

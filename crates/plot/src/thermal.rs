@@ -10,8 +10,7 @@ use whirlmap_core::thermal::network::NODES;
 use whirlmap_core::thermal::ThermalSample;
 
 use crate::render::{
-    chart_header, chart_mesh, chart_text_style, draw_thin_line, render, DrawResult, Figure,
-    RenderError,
+    draw_mesh, draw_thin_line, render, text_style, with_header, DrawResult, Figure, RenderError,
 };
 
 /// Size (width, height) in pixels of the temperature figure.
@@ -74,7 +73,7 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 impl Figure for TemperatureFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let body = chart_header(root, 46, self.title, 22.0)?;
+        let body = with_header(root, 46, self.title, 22.0)?;
         let h = body.dim_in_pixel().1 as f64;
         let (top, rest) = body.split_vertically((h * 0.56).round() as u32);
         let (middle, bottom) = rest.split_vertically((h * 0.22).round() as u32);
@@ -116,7 +115,7 @@ impl TemperatureFigure<'_> {
         } else {
             "Node temperatures".to_string()
         };
-        let area = chart_header(area, 34, &caption, 17.0)?;
+        let area = with_header(area, 34, &caption, 17.0)?;
         let (t0, t1) = self.t_range();
         let (y0, y1) = range(
             self.series
@@ -130,7 +129,7 @@ impl TemperatureFigure<'_> {
             .x_label_area_size(48)
             .y_label_area_size(78)
             .build_cartesian_2d(t0..t1, y0..y1)?;
-        chart_mesh(&mut chart, "time (s)", "temperature (K)", 10, 8)?;
+        draw_mesh(&mut chart, "time (s)", "temperature (K)", 10, 8)?;
         for k in 0..NODES {
             let pts: Vec<(f64, f64)> = self
                 .series
@@ -150,7 +149,7 @@ impl TemperatureFigure<'_> {
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperLeft)
-            .label_font(chart_text_style(14.0))
+            .label_font(text_style(14.0))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK.mix(0.3))
             .draw()?;
@@ -176,7 +175,7 @@ impl TemperatureFigure<'_> {
         } else {
             title.to_string()
         };
-        let area = chart_header(area, 34, &caption, 17.0)?;
+        let area = with_header(area, 34, &caption, 17.0)?;
         let (t0, t1) = self.t_range();
         let (lo, hi) = range(self.series.iter().map(&value));
         let mut chart = ChartBuilder::on(&area)
@@ -187,7 +186,7 @@ impl TemperatureFigure<'_> {
             .x_label_area_size(48)
             .y_label_area_size(78)
             .build_cartesian_2d(t0..t1, lo.min(0.0)..hi.max(1.0))?;
-        chart_mesh(&mut chart, "time (s)", y_desc, 10, 4)?;
+        draw_mesh(&mut chart, "time (s)", y_desc, 10, 4)?;
         let pts: Vec<(f64, f64)> = self
             .series
             .iter()

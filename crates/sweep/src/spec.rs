@@ -554,30 +554,26 @@ fn check_range(field: &str, from: f64, to: f64) -> Result<(), SpecError> {
 /// ([`SweepSpec::validate`]: the grid's size first, before any axis is built). A sweep checks
 /// the points' scenes itself before it runs ([`crate::sweep::run_sweep`]), one at a time.
 pub fn read(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
-    let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| SpecError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let spec = parse(&text).map_err(|source| SpecError::Parse {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let spec = read_unchecked(path.as_ref())?;
     spec.validate()?;
     Ok(spec)
 }
 
-/// Reads, parses and validates a spec (every grid point's scene included).
-pub fn load(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
-    let path = path.as_ref();
+/// Reads and parses a spec file, checking nothing beyond its JSON shape.
+fn read_unchecked(path: &Path) -> Result<SweepSpec, SpecError> {
     let text = std::fs::read_to_string(path).map_err(|source| SpecError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    let spec = parse(&text).map_err(|source| SpecError::Parse {
+    parse(&text).map_err(|source| SpecError::Parse {
         path: path.to_path_buf(),
         source,
-    })?;
+    })
+}
+
+/// Reads, parses and validates a spec (every grid point's scene included).
+pub fn load(path: impl AsRef<Path>) -> Result<SweepSpec, SpecError> {
+    let spec = read_unchecked(path.as_ref())?;
     spec.check_points()?;
     Ok(spec)
 }
