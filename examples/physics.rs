@@ -15,7 +15,8 @@
 //!    release speeds with the time the race first locks into rolling. While the contact
 //!    slips, Coulomb friction `mu F_n` does not depend on the slip speed, so the rotor's
 //!    translation is the same at every release speed until the race locks: the study
-//!    measures when each path leaves the 30 000 r/min path.
+//!    measures when each path leaves the 30 000 r/min path. The traces run at the
+//!    `reference` numerics; the classes at the scene's default (`standard`).
 //! 2. **Threshold map.** Class over friction (0.20 to 0.40 in 0.005) and speed (2 000 to
 //!    30 000 r/min).
 //! 3. **Sensitivities.** The friction threshold at 16 000 r/min (the lowest mu above which
@@ -32,7 +33,7 @@ use serde::Serialize;
 use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 use whirlmap_core::orbit::OrbitSample;
-use whirlmap_core::{simulate, DropOptions, OrbitClass, Scene};
+use whirlmap_core::{simulate, DropOptions, Fidelity, OrbitClass, Scene};
 use whirlmap_plot::marks::{class_colour, legend, Mark};
 use whirlmap_plot::render::{
     draw_mesh, render, with_header, DrawResult, Figure, TITLE_BAND, TITLE_FONT, X_LABEL_AREA,
@@ -54,8 +55,11 @@ fn class_of(s: &Scene) -> Option<OrbitClass> {
     simulate(s, &opts).ok().map(|r| r.verdict.class)
 }
 
-/// A trace of the first `duration_s` with the whirl rule and the extension off.
+/// A trace of the first `duration_s` with the whirl rule and the extension off, at the
+/// `reference` numerics: the traces are compared to 5 um, finer than `standard` resolves
+/// (at rtol 3e-5 two paths of the same physics drift 5 um apart within a few bounces).
 fn trace(mut s: Scene, duration_s: f64) -> Vec<OrbitSample> {
+    Fidelity::Reference.apply(&mut s);
     s.whirl_stop_turns = 1e6;
     s.classification.max_extension_s = 0.0;
     let opts = DropOptions {
