@@ -193,9 +193,39 @@ impl EnergyAudit {
     }
 }
 
+/// What a drop was asked to do: the operating point, the simulated time asked for and every
+/// scene field that differs from the paper's scene, so that a record can be read without
+/// the file or command that made it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DropInputs {
+    /// Rotor speed at release (r/min).
+    pub speed_rpm: f64,
+    /// Dynamic friction coefficient rotor-race (eq. 8).
+    pub mu: f64,
+    /// Simulated time asked for (s), before any extension by the classifier.
+    pub duration_s: f64,
+    /// Every other scene field that differs from [`Scene::paper`], by dotted key
+    /// ([`crate::scene::scene_changes`]); empty for the paper's scene.
+    pub scene_changes: std::collections::BTreeMap<String, serde_json::Value>,
+}
+
+impl DropInputs {
+    /// The inputs of a drop of `scene` run for `duration_s`.
+    pub fn new(scene: &Scene, duration_s: f64) -> Self {
+        Self {
+            speed_rpm: scene.speed_rpm,
+            mu: scene.mu_dynamic,
+            duration_s,
+            scene_changes: crate::scene::scene_changes(scene),
+        }
+    }
+}
+
 /// Everything one drop produced.
 #[derive(Debug, Clone)]
 pub struct DropReport {
+    /// What the drop was asked to do.
+    pub inputs: DropInputs,
     /// Streamed measurements (peaks, impacts, whirl, window statistics).
     pub features: Features,
     /// The energy audit.
@@ -465,6 +495,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
     let verdict = classify(&features, stop_reason, cls);
     let thermal = thermal.map(|th| th.finish(t, &y));
     Ok(DropReport {
+        inputs: DropInputs::new(scene, opts.duration_s),
         features,
         energy,
         stats: stepper.stats(),

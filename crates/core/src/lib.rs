@@ -76,7 +76,8 @@ pub mod thermal;
 
 pub use classify::{classify, ClassifyParams, OrbitClass, Reason, Verdict};
 pub use drop::{
-    simulate, simulate_observed, DropOptions, DropReport, EnergyAudit, StopReason, MODEL_VERSION,
+    simulate, simulate_observed, DropInputs, DropOptions, DropReport, EnergyAudit, StopReason,
+    MODEL_VERSION,
 };
 pub use error::{InvalidParameter, SolveError};
 pub use fidelity::Fidelity;

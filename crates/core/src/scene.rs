@@ -763,6 +763,44 @@ impl Scene {
     }
 }
 
+/// Every field of `scene` whose value differs from [`Scene::paper`]'s, by dotted key
+/// (`solver.rtol`, `classification.window_s`), as JSON values; the operating point
+/// (`speed_rpm`, `mu_dynamic`) is left out, since a record carries it on its own. A nested
+/// object the default does not have (`thermal`) or whose kind differs (`friction_law`) is
+/// one entry. Keys are sorted, so equal scenes give equal maps.
+pub fn scene_changes(scene: &Scene) -> std::collections::BTreeMap<String, serde_json::Value> {
+    fn walk(
+        prefix: &str,
+        now: &serde_json::Value,
+        base: Option<&serde_json::Value>,
+        out: &mut std::collections::BTreeMap<String, serde_json::Value>,
+    ) {
+        match (now, base) {
+            (serde_json::Value::Object(m), Some(serde_json::Value::Object(b))) => {
+                for (k, v) in m {
+                    let key = if prefix.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{prefix}.{k}")
+                    };
+                    walk(&key, v, b.get(k), out);
+                }
+            }
+            (v, b) if b != Some(v) => {
+                out.insert(prefix.to_string(), v.clone());
+            }
+            _ => {}
+        }
+    }
+    let now = serde_json::to_value(scene).unwrap_or_default();
+    let base = serde_json::to_value(Scene::paper()).unwrap_or_default();
+    let mut out = std::collections::BTreeMap::new();
+    walk("", &now, Some(&base), &mut out);
+    out.remove("speed_rpm");
+    out.remove("mu_dynamic");
+    out
+}
+
 /// Canonical text of the scene: serde_json keeps the struct's field order and prints floats
 /// in shortest round-trip form, so equal scenes give equal text on every platform.
 fn canonical_json<T: Serialize>(v: &T) -> String {
@@ -782,6 +820,30 @@ pub fn fnv1a64(bytes: &[u8]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scene_changes_name_exactly_the_fields_that_differ() {
+        let mut s = Scene::paper();
+        s.speed_rpm = 12_000.0;
+        s.mu_dynamic = 0.3;
+        assert!(
+            scene_changes(&s).is_empty(),
+            "speed and mu are carried on their own"
+        );
+        s.solver.rtol = 1e-7;
+        s.support_damper = SupportDamper::RadialOnly;
+        s.unbalance_m = 2e-6;
+        s.thermal = Some(ThermalParams::default());
+        let c = scene_changes(&s);
+        let keys: Vec<&str> = c.keys().map(String::as_str).collect();
+        assert_eq!(
+            keys,
+            ["solver.rtol", "support_damper", "thermal", "unbalance_m"]
+        );
+        assert_eq!(c["solver.rtol"], serde_json::json!(1e-7));
+        assert_eq!(c["support_damper"], serde_json::json!("radial_only"));
+        assert!(c["thermal"].is_object());
+    }
 
     #[test]
     fn paper_scene_is_valid_and_converts_table4_units() {

@@ -5,11 +5,16 @@ use serde::{Deserialize, Serialize};
 use whirlmap_core::classify::{OrbitClass, Reason};
 use whirlmap_core::ode::Stats;
 use whirlmap_core::thermal::{HeatEnergies, NodeTemperatures};
-use whirlmap_core::{DropReport, EnergyAudit, Features, StopReason, MODEL_VERSION};
+use whirlmap_core::{DropInputs, DropReport, EnergyAudit, Features, StopReason, MODEL_VERSION};
 
 /// One drop's outputs, as written by `whirlmap drop --json` and, per point, by sweeps.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DropRecord {
+    /// What the drop was asked to do: speed, friction coefficient, duration and every scene
+    /// field that differs from the paper's scene, so the record stands alone. Always written;
+    /// absent only in records made before the records carried their inputs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inputs: Option<DropInputs>,
     /// Orbit class: the motion the rotor settled into ([`whirlmap_core::classify`]).
     pub class: OrbitClass,
     /// Why it got that class; for `unresolved`, why it had not settled at the cap.
@@ -64,6 +69,7 @@ impl DropRecord {
     pub fn from_report(r: &DropReport) -> Self {
         let f = &r.features;
         Self {
+            inputs: Some(r.inputs.clone()),
             class: r.verdict.class,
             class_reason: r.verdict.reason,
             transient_whirl_turns: f.transient_whirl_turns,
