@@ -179,8 +179,13 @@ fn build_scene_with(
         Some(p) => {
             let text = std::fs::read_to_string(p)
                 .with_context(|| format!("cannot read scene file {}", p.display()))?;
-            whirlmap_core::json::from_str::<Scene>(&text)
-                .with_context(|| format!("scene file {}", p.display()))?
+            whirlmap_core::json::from_str::<Scene>(&text).map_err(|e| {
+                anyhow::anyhow!(
+                    "scene file {}: {}",
+                    p.display(),
+                    whirlmap_sweep::overrides::with_suggestion(&e.to_string())
+                )
+            })?
         }
         None => Scene::paper(),
     };

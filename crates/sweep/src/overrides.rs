@@ -14,10 +14,12 @@ pub enum OverrideError {
     #[error("expected key=value, got `{0}`")]
     Syntax(String),
     /// The key is not a scene parameter.
-    #[error("unknown scene parameter `{key}`; known: {known}")]
+    #[error("unknown scene parameter `{key}`{}; known: {known}", did_you_mean_text(suggestion.as_deref()))]
     UnknownKey {
         /// The key as given.
         key: String,
+        /// The closest known key, when one is close enough to be a misspelling.
+        suggestion: Option<String>,
         /// The known keys at that level, comma-separated.
         known: String,
     },
@@ -29,6 +31,41 @@ pub enum OverrideError {
         /// What serde said.
         reason: String,
     },
+}
+
+/// The known name closest to `given`, when it is close enough to be a misspelling of it
+/// (Jaro-Winkler similarity of at least 0.8: `clearence_m` gives `clearance_m`, `rtl`
+/// gives `rtol`; a name unlike every known one gives `None`).
+pub fn did_you_mean<'a>(given: &str, known: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    known
+        .into_iter()
+        .map(|k| (strsim::jaro_winkler(given, k), k))
+        .filter(|(score, _)| *score >= 0.8)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, k)| k)
+}
+
+/// " (did you mean `x`?)" or nothing.
+fn did_you_mean_text(suggestion: Option<&str>) -> String {
+    suggestion
+        .map(|s| format!(" (did you mean `{s}`?)"))
+        .unwrap_or_default()
+}
+
+/// Adds a "did you mean" to serde's `unknown field `x`, expected one of `a`, `b`` message
+/// (a scene or sweep file with a misspelt key); any other message is returned as it is.
+pub fn with_suggestion(message: &str) -> String {
+    let Some(rest) = message.split("unknown field `").nth(1) else {
+        return message.to_string();
+    };
+    let Some((given, tail)) = rest.split_once('`') else {
+        return message.to_string();
+    };
+    let known: Vec<&str> = tail.split('`').skip(1).step_by(2).collect();
+    match did_you_mean(given, known) {
+        Some(best) => format!("{message} (did you mean `{best}`?)"),
+        None => message.to_string(),
+    }
 }
 
 /// Parses `key=value` and applies it to `scene`.
@@ -73,6 +110,7 @@ pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), Overri
             _ => {
                 return Err(OverrideError::UnknownKey {
                     key: key.to_string(),
+                    suggestion: None,
                     known: String::new(),
                 });
             }
@@ -90,9 +128,17 @@ pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), Overri
                     known.push(name.to_string());
                 }
             }
+            let suggestion = did_you_mean(part, known.iter().map(String::as_str)).map(|best| {
+                if parent.is_empty() {
+                    best.to_string()
+                } else {
+                    format!("{parent}.{best}")
+                }
+            });
             let known = known.join(", ");
             return Err(OverrideError::UnknownKey {
                 key: key.to_string(),
+                suggestion,
                 known,
             });
         }
@@ -105,6 +151,7 @@ pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), Overri
         let Some(next) = obj.get_mut(*part) else {
             return Err(OverrideError::UnknownKey {
                 key: key.to_string(),
+                suggestion: None,
                 known: format!("none (`{part}` is not set in this scene: set it whole first, e.g. `--set {part}={{}}`, or use --thermal)"),
             });
         };
@@ -117,6 +164,31 @@ pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), Overri
 mod tests {
     use super::*;
     use whirlmap_core::FrictionLaw;
+
+    #[test]
+    fn a_misspelt_key_gets_the_closest_known_one() {
+        let mut s = Scene::paper();
+        let e = apply_assignment(&mut s, "clearence_m=1e-4").unwrap_err();
+        assert!(
+            e.to_string().contains("(did you mean `clearance_m`?)"),
+            "{e}"
+        );
+        let e = apply_assignment(&mut s, "solver.rtl=1e-4").unwrap_err();
+        assert!(
+            e.to_string().contains("(did you mean `solver.rtol`?)"),
+            "{e}"
+        );
+        let e = apply_assignment(&mut s, "zzzz=1").unwrap_err();
+        assert!(!e.to_string().contains("did you mean"), "{e}");
+        // serde's message for a scene or sweep file
+        let text = r#"{"clearence_m": 1e-4}"#;
+        let err = whirlmap_core::json::from_str::<Scene>(text).unwrap_err();
+        assert!(
+            with_suggestion(&err.to_string()).ends_with("(did you mean `clearance_m`?)"),
+            "{err}"
+        );
+        assert_eq!(with_suggestion("expected value"), "expected value");
+    }
 
     #[test]
     fn optional_fields_are_settable_and_absent_sections_are_an_error_not_a_panic() {

@@ -56,7 +56,7 @@ pub enum SpecError {
         source: std::io::Error,
     },
     /// Not valid JSON, an unknown key or a wrong type (serde's message has line and column).
-    #[error("sweep spec {path}: {source}")]
+    #[error("sweep spec {path}: {}", crate::overrides::with_suggestion(&source.to_string()))]
     Parse {
         /// The spec file.
         path: PathBuf,
