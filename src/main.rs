@@ -39,12 +39,60 @@ struct Cli {
     command: Command,
 }
 
+/// `whirlmap scene`'s options.
+#[derive(clap::Args)]
+struct SceneArgs {
+    /// Also give the thermal model's parameters their defaults (`thermal` is `null`, the
+    /// model off, without it; a scene file with them switches the thermal model on).
+    #[arg(long)]
+    all: bool,
+    /// Print the scene's JSON Schema instead: type, default, unit (`x-unit`), allowed range
+    /// (`minimum`, `maximum`, or their exclusive forms), source (`x-source`) and description
+    /// of every field, derived from the same types the scene is read with.
+    #[arg(long, conflicts_with = "all")]
+    schema: bool,
+}
+
+/// The paper's scene with every field a scene file accepts: the fields a scene may leave out
+/// (at their defaults) follow the rest.
+#[derive(serde::Serialize)]
+struct FullScene<'a> {
+    #[serde(flatten)]
+    scene: &'a Scene,
+    release_offset_m: [f64; 2],
+    release_velocity_m_s: [f64; 2],
+    race_speed_rad_s: f64,
+    quasi_static_race: bool,
+    stop_speed_rpm: Option<f64>,
+    thermal: Option<whirlmap_core::ThermalParams>,
+}
+
+/// What `whirlmap scene` prints.
+fn scene_text(a: &SceneArgs) -> String {
+    if a.schema {
+        let schema = whirlmap_core::schema::scene_schema();
+        return serde_json::to_string_pretty(&schema).expect("the schema serialises");
+    }
+    let paper = Scene::paper();
+    let full = FullScene {
+        scene: &paper,
+        release_offset_m: paper.release_offset_m,
+        release_velocity_m_s: paper.release_velocity_m_s,
+        race_speed_rad_s: paper.race_speed_rad_s,
+        quasi_static_race: paper.quasi_static_race,
+        stop_speed_rpm: paper.stop_speed_rpm,
+        thermal: a.all.then(whirlmap_core::ThermalParams::default),
+    };
+    serde_json::to_string_pretty(&full).expect("scene serialises")
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Simulate one drop and print its outputs.
     Drop(DropArgs),
-    /// Print the default scene (the paper's) as JSON: a starting file for --scene.
-    Scene,
+    /// Print the default scene (the paper's) as JSON, every accepted field with its default:
+    /// a starting file for --scene. Units, ranges and sources: `--schema`.
+    Scene(SceneArgs),
     /// Time a pendulum drop, a whirl drop and one right-hand-side evaluation.
     Bench(bench::BenchArgs),
     /// Draw the design charts (Figs. 3-6, class map) of a sweep's results directory into
@@ -370,11 +418,8 @@ fn run() -> u8 {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Drop(a) => run_drop(a),
-        Command::Scene => {
-            outln!(
-                "{}",
-                serde_json::to_string_pretty(&Scene::paper()).expect("scene serialises")
-            );
+        Command::Scene(a) => {
+            outln!("{}", scene_text(a));
             Ok(())
         }
         Command::Bench(a) => bench::run(a).map_err(Failure::Solve),

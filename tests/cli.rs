@@ -173,6 +173,55 @@ fn scene_file_with_unknown_key_reports_line_and_column() {
         err.contains("clearence_m") && err.contains("line 3"),
         "{err}"
     );
+    assert!(err.contains("did you mean `clearance_m`?"), "{err}");
+}
+
+#[test]
+fn scene_prints_every_field_the_schema_lists_and_the_schema_says_units_and_ranges() {
+    let scene: serde_json::Value = serde_json::from_slice(&whirlmap(&["scene"]).stdout).unwrap();
+    let schema_out = whirlmap(&["scene", "--schema"]);
+    assert!(schema_out.status.success());
+    let schema: serde_json::Value = serde_json::from_slice(&schema_out.stdout).unwrap();
+    let printed: Vec<&String> = scene.as_object().unwrap().keys().collect();
+    let listed: Vec<&String> = schema["properties"].as_object().unwrap().keys().collect();
+    let mut a = printed.clone();
+    let mut b = listed.clone();
+    a.sort();
+    b.sort();
+    assert_eq!(a, b, "`whirlmap scene` and its schema list the same fields");
+    for optional in [
+        "release_offset_m",
+        "stop_speed_rpm",
+        "thermal",
+        "quasi_static_race",
+    ] {
+        assert!(scene.get(optional).is_some(), "{optional} not printed");
+    }
+    assert!(
+        scene["thermal"].is_null(),
+        "the thermal model is off by default"
+    );
+    let rpm = &schema["properties"]["speed_rpm"];
+    assert_eq!(rpm["x-unit"], "r/min");
+    assert_eq!(rpm["maximum"], 1e6);
+    assert_eq!(rpm["default"], 8000.0);
+    let all: serde_json::Value =
+        serde_json::from_slice(&whirlmap(&["scene", "--all"]).stdout).unwrap();
+    assert_eq!(all["thermal"]["ambient_temperature_k"], 293.15);
+    // every printed field is accepted back: the full file is the default scene
+    let p = temp_path("full-scene.json");
+    std::fs::write(&p, serde_json::to_string(&scene).unwrap()).unwrap();
+    let a = whirlmap(&[
+        "drop",
+        "--scene",
+        p.to_str().unwrap(),
+        "--duration-s",
+        "0.02",
+        "--json",
+    ]);
+    let b = whirlmap(&["drop", "--duration-s", "0.02", "--json"]);
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    assert_eq!(a.stdout, b.stdout);
 }
 
 #[test]

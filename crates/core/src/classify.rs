@@ -167,6 +167,7 @@ impl Verdict {
 
 /// Thresholds of the classifier and the extension of undecided runs. Part of the scene
 /// (`classification`), so they are part of every record's key.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ClassifyParams {

@@ -72,6 +72,7 @@ pub mod monitor;
 pub mod ode;
 pub mod orbit;
 pub mod scene;
+pub mod schema;
 pub mod thermal;
 
 pub use classify::{classify, ClassifyParams, OrbitClass, Reason, Verdict};

@@ -11,6 +11,7 @@ use crate::thermal::ThermalParams;
 use serde::{Deserialize, Serialize};
 
 /// How friction at the rotor-race contact is modelled.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum FrictionLaw {
@@ -26,6 +27,7 @@ pub enum FrictionLaw {
 }
 
 /// The Runge-Kutta pair a drop is integrated with.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
@@ -49,6 +51,7 @@ pub enum Method {
 /// along its own line; summed over a half-loaded zone the set's damping matrix is
 /// `c diag(sum cos^2 psi, sum sin^2 psi)`, equal terms, so a ball set damps the race's
 /// tangential motion as much as its radial motion.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SupportDamper {
@@ -64,6 +67,7 @@ pub enum SupportDamper {
 }
 
 /// Integrator settings that change results (so they are part of the scene and its hash).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverSettings {
@@ -127,6 +131,7 @@ impl Default for SolverSettings {
 
 /// One rotor, one touchdown location, one release. All fields SI unless the name says
 /// otherwise. `Scene::default()` is [`Scene::paper`].
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Scene {
@@ -406,8 +411,21 @@ impl Scene {
         self.speed_rpm * std::f64::consts::PI / 30.0
     }
 
-    /// Checks every field against its allowed range; the error names the first that fails.
+    /// Checks every field against its allowed range, then the fields' consistency with each
+    /// other ([`Scene::validate_consistency`]) and the thermal model's; the error names the
+    /// first field that fails.
     pub fn validate(&self) -> Result<(), InvalidParameter> {
+        self.validate_fields()?;
+        self.validate_consistency()?;
+        if let Some(t) = &self.thermal {
+            t.validate_with(self.race_bore_radius_m(), self.pitch_diameter_m)?;
+        }
+        Ok(())
+    }
+
+    /// Checks each field of the scene (not of its thermal model) against its own allowed
+    /// range ([`crate::schema::FIELD_RANGES`] lists them).
+    pub fn validate_fields(&self) -> Result<(), InvalidParameter> {
         fn check(field: &str, v: f64, ok: bool, allowed: &str) -> Result<(), InvalidParameter> {
             if v.is_finite() && ok {
                 Ok(())
@@ -643,10 +661,6 @@ impl Scene {
                 (0.0..=1e6).contains(&v),
                 "[0, 1e6] r/min",
             )?;
-        }
-        self.validate_consistency()?;
-        if let Some(t) = &self.thermal {
-            t.validate_with(self.race_bore_radius_m(), self.pitch_diameter_m)?;
         }
         Ok(())
     }

@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 
 /// The thermal model's parameters (paper Sec. 3, eqs. 18-31). A scene switches the thermal
 /// model on by carrying one of these (`"thermal": {}` takes every default).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ThermalParams {
