@@ -16,9 +16,13 @@ pub struct AccuracyArgs {
     /// Case file (JSON): cases, tolerance ladder, settings.
     #[arg(long, default_value = "sweeps/accuracy-cases.json")]
     cases: PathBuf,
-    /// Output folder.
+    /// Output folder. A folder that already holds results (the committed `results/accuracy`
+    /// among them) is refused without --overwrite.
     #[arg(long, default_value = "results/accuracy")]
     out: PathBuf,
+    /// Replace the results already in the output folder.
+    #[arg(long)]
+    overwrite: bool,
     /// Worker threads (1 gives the cleanest wall times); default 1.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
     threads: u32,
@@ -27,6 +31,7 @@ pub struct AccuracyArgs {
 /// Runs the study and writes `accuracy.csv`, `accuracy.md`, `study.json` and the charts.
 pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
     let spec = AccuracySpec::load(&a.cases).map_err(|e| Failure::Input(e.into()))?;
+    crate::refuse_existing_results(&a.out, a.overwrite).map_err(Failure::Input)?;
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create {}", a.out.display()))
         .map_err(Failure::Output)?;

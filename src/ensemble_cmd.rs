@@ -16,9 +16,13 @@ pub struct EnsembleArgs {
     /// Ensemble file (JSON): a sweep file (name, scene, duration_s, axes) with an `ensemble`
     /// section (and, for `adaptive`, an `adaptive` section).
     file: PathBuf,
-    /// Output folder; default `results/<name>`.
+    /// Output folder; default `results/<name>`. A folder that already holds results (a
+    /// committed one among them) is refused without --overwrite.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace the results already in the output folder.
+    #[arg(long)]
+    overwrite: bool,
     /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     threads: Option<u32>,
@@ -43,6 +47,10 @@ fn load(a: &EnsembleArgs, what: &str) -> Result<(ensemble::EnsembleSpec, PathBuf
                 .out
                 .clone()
                 .unwrap_or_else(|| PathBuf::from("results").join(&s.name));
+            if let Err(e) = crate::refuse_existing_results(&out, a.overwrite) {
+                errln!("error: {e}");
+                return Err(2);
+            }
             let lock = std::fs::create_dir_all(&out)
                 .map_err(|e| whirlmap_sweep::folder::output_error(&out, e))
                 .and_then(|_| FolderLock::acquire(&out, what))
@@ -85,7 +93,15 @@ pub fn run_ensemble_cmd(a: &EnsembleArgs) -> u8 {
         o.failed
     );
     for g in &o.contours.groups {
-        let label = serde_json::to_string(&g.inputs).unwrap_or_default();
+        let label = if g.inputs.is_empty() {
+            "all cells".to_string()
+        } else {
+            g.inputs
+                .iter()
+                .map(|(k, v)| format!("{k} {v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         let levels: Vec<String> = g
             .levels
             .iter()

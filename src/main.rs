@@ -39,6 +39,39 @@ struct Cli {
     command: Command,
 }
 
+/// Refuses to write into `out` when it already holds results (any file but the writers'
+/// lock) and `overwrite` is not set, so a command's default folder (`results/...`, which may
+/// be committed reference output) is never replaced by accident. The message names the
+/// folder, what is in it, and the two ways on.
+pub(crate) fn refuse_existing_results(
+    out: &std::path::Path,
+    overwrite: bool,
+) -> anyhow::Result<()> {
+    if overwrite {
+        return Ok(());
+    }
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Ok(());
+    };
+    let mut held: Vec<String> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n != ".whirlmap.lock")
+        .collect();
+    if held.is_empty() {
+        return Ok(());
+    }
+    held.sort();
+    let shown = held.iter().take(3).cloned().collect::<Vec<_>>().join(", ");
+    anyhow::bail!(
+        "output folder {} already holds results ({} entries: {shown}{}); pass --overwrite to \
+         replace them, or choose another folder with --out",
+        out.display(),
+        held.len(),
+        if held.len() > 3 { ", ..." } else { "" }
+    )
+}
+
 /// `whirlmap scene`'s options.
 #[derive(clap::Args)]
 struct SceneArgs {

@@ -282,3 +282,31 @@ fn orbit_option_draws_a_well_formed_svg() {
         "{text}"
     );
 }
+
+#[test]
+fn commands_refuse_a_folder_that_holds_results_without_overwrite() {
+    let dir = temp_path("held");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("accuracy.md"), "kept").unwrap();
+    for args in [
+        vec!["accuracy", "--out", dir.to_str().unwrap()],
+        vec![
+            "ensemble",
+            "sweeps/ensemble-smoke.json",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+    ] {
+        let out = whirlmap(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("already holds results") && err.contains("--overwrite"),
+            "{err}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.join("accuracy.md")).unwrap(),
+            "kept"
+        );
+    }
+}
