@@ -286,6 +286,27 @@ fn build_scene_with(
     Ok(scene)
 }
 
+/// The scene's physical settings that differ from the paper's, for a chart title:
+/// `, unbalance_m 5e-6, support_damper radial_only` (the numerics, `solver.*` and
+/// `classification.*`, and the thermal model's parameters are left out; at most three, then
+/// "and N more").
+fn settings_note(scene: &Scene) -> String {
+    let changes: Vec<String> = whirlmap_core::scene::scene_changes(scene)
+        .into_iter()
+        .filter(|(k, _)| !k.starts_with("solver.") && !k.starts_with("classification."))
+        .map(|(k, v)| match v {
+            serde_json::Value::String(s) => format!("{k} {s}"),
+            serde_json::Value::Object(_) if k == "thermal" => "thermal model".to_string(),
+            v => format!("{k} {v}"),
+        })
+        .collect();
+    match changes.len() {
+        0 => String::new(),
+        n if n <= 3 => format!(", {}", changes.join(", ")),
+        n => format!(", {} and {} more", changes[..3].join(", "), n - 3),
+    }
+}
+
 fn run_drop(a: &DropArgs) -> Result<(), Failure> {
     let thermal = a.thermal || a.temperatures.is_some();
     let mut scene = build_scene_with(a.scene.as_deref(), &a.set, a.speed_rpm, a.mu, thermal)
@@ -293,8 +314,10 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
     if let Some(f) = a.fidelity {
         f.apply(&mut scene);
     }
+    // Output paths are checked before the drop runs, not after.
     for p in [&a.orbit, &a.temperatures].into_iter().flatten() {
         ImageFormat::from_path(p).map_err(|e| Failure::Input(e.into()))?;
+        whirlmap_plot::render::check_writable(p).map_err(|e| Failure::Output(e.into()))?;
     }
     let opts = DropOptions {
         duration_s: a.duration_s,
@@ -309,17 +332,21 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
     let record = DropRecord::from_report(&report);
     if let (Some(path), Some(orbit)) = (&a.orbit, &report.orbit) {
         let title = format!(
-            "{:.0} r/min, mu = {:.2}: {}",
+            "{:.0} r/min, mu = {:.2}{}: {}",
             scene.speed_rpm,
             scene.mu_dynamic,
+            settings_note(&scene),
             record.class.label()
         );
         draw_orbit(path, &title, orbit).map_err(|e| Failure::Output(e.into()))?;
     }
     if let (Some(path), Some(th)) = (&a.temperatures, &report.thermal) {
         let title = format!(
-            "{:.0} r/min, mu = {:.2}: touchdown bearing temperatures over {:.1} s",
-            scene.speed_rpm, scene.mu_dynamic, report.end_time_s
+            "{:.0} r/min, mu = {:.2}{}: touchdown bearing temperatures over {:.1} s",
+            scene.speed_rpm,
+            scene.mu_dynamic,
+            settings_note(&scene),
+            report.end_time_s
         );
         draw_temperatures(path, &title, &th.series).map_err(|e| Failure::Output(e.into()))?;
     }

@@ -310,3 +310,16 @@ fn commands_refuse_a_folder_that_holds_results_without_overwrite() {
         );
     }
 }
+
+#[test]
+fn an_unwritable_chart_path_is_refused_in_a_sentence_before_the_drop_runs() {
+    let out = whirlmap(&["drop", "--orbit", "/nonexistent-folder/x.png", "--json"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(4), "{err}");
+    assert!(
+        err.contains("cannot write chart /nonexistent-folder/x.png: the folder /nonexistent-folder does not exist"),
+        "{err}"
+    );
+    assert!(!err.contains("Os {"), "no error dump: {err}");
+    assert!(out.stdout.is_empty(), "nothing was simulated or printed");
+}

@@ -86,13 +86,14 @@ pub trait Figure {
 /// Registers the embedded font first. On a drawing error, any partly written file is removed.
 pub fn render<F: Figure>(path: &Path, size: (u32, u32), figure: &F) -> Result<(), RenderError> {
     let format = ImageFormat::from_path(path)?;
+    check_writable(path)?;
     fonts::register_embedded_fonts().map_err(|cause| RenderError::Font {
         path: path.to_path_buf(),
         cause,
     })?;
     let fail = |cause: &dyn Display| RenderError::Draw {
         path: path.to_path_buf(),
-        cause: cause.to_string(),
+        cause: plain_cause(&cause.to_string()),
     };
     if size.0 == 0 || size.1 == 0 {
         return Err(fail(&format_args!(
@@ -118,6 +119,60 @@ pub fn render<F: Figure>(path: &Path, size: (u32, u32), figure: &F) -> Result<()
         let _ = std::fs::remove_file(path);
     }
     result
+}
+
+/// Checks, before anything is drawn, that `path` can be written, so a chart that cannot be
+/// saved fails with a sentence (which folder is missing, or that permission is denied)
+/// instead of the backend's error dump after the drawing.
+pub fn check_writable(path: &Path) -> Result<(), RenderError> {
+    let fail = |cause: String| RenderError::Draw {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !parent.is_dir() {
+        return Err(fail(format!(
+            "the folder {} does not exist",
+            parent.display()
+        )));
+    }
+    if path.is_dir() {
+        return Err(fail("it is a folder".to_string()));
+    }
+    let existed = path.exists();
+    match std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(path)
+    {
+        Ok(_) => {
+            if !existed {
+                let _ = std::fs::remove_file(path);
+            }
+            Ok(())
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::PermissionDenied => {
+            Err(fail("permission denied".to_string()))
+        }
+        Err(e) => Err(fail(e.to_string())),
+    }
+}
+
+/// The backend's error in words: plotters nests the I/O error in debug dumps
+/// (`ImageError(IoError(Os { code: 28, kind: StorageFull, message: "No space left on
+/// device" }))`); the OS message is what a person needs.
+fn plain_cause(text: &str) -> String {
+    match text
+        .split("message: \"")
+        .nth(1)
+        .and_then(|m| m.split('"').next())
+    {
+        Some(message) => message.to_string(),
+        None => text.to_string(),
+    }
 }
 
 pub(crate) fn draw_and_present<DB: DrawingBackend, F: Figure>(
