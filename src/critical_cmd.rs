@@ -11,9 +11,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 use whirlmap_core::InvalidParameter;
 use whirlmap_sweep::critical::{
-    check_mus, critical_rows, csv_text, fmt_rpm, CriticalOptions, CriticalRow,
+    check_mus, critical_rows_ticked, csv_text, fmt_rpm, CriticalOptions, CriticalRow,
     DEFAULT_RESOLUTION_RPM, DEFAULT_TOL_RPM,
 };
+use whirlmap_sweep::progress::Ticker;
 use whirlmap_sweep::recheck::recheck_bracket;
 
 #[derive(clap::Args)]
@@ -60,6 +61,9 @@ pub struct CriticalArgs {
     /// then re-checked at the next tighter preset (recorded as `recheck`).
     #[arg(long)]
     fidelity: Option<whirlmap_core::Fidelity>,
+    /// No progress (by default a bar on a terminal, a plain line every 5 s otherwise).
+    #[arg(long)]
+    no_progress: bool,
 }
 
 /// Names a bad flag: `--from = -5: allowed ...`.
@@ -106,7 +110,10 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
     }
 
     let start = Instant::now();
-    let mut rows = critical_rows(&base, &a.mu, &opts).map_err(|e| Failure::Input(e.into()))?;
+    let label = format!("critical search, {} friction coefficient(s)", a.mu.len());
+    let ticker = Ticker::new(&label, 0, !a.no_progress);
+    let mut rows =
+        critical_rows_ticked(&base, &a.mu, &opts, &ticker).map_err(|e| Failure::Input(e.into()))?;
     if let Some(tighter) = a.fidelity.and_then(|f| f.tighter()) {
         let drop_opts = whirlmap_core::DropOptions {
             duration_s: a.duration_s,

@@ -27,6 +27,7 @@
 //! predicate, testable without the integrator.
 
 use crate::classify::OrbitClass;
+use crate::progress::Ticker;
 use crate::run::{run_drop, DropFailure};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -535,7 +536,21 @@ pub fn critical_rows(
     mus: &[f64],
     o: &CriticalOptions,
 ) -> Result<Vec<CriticalRow>, InvalidParameter> {
+    critical_rows_ticked(base, mus, o, &Ticker::off())
+}
+
+/// [`critical_rows`], counting every finished drop on `ticker` (progress for a search that
+/// takes seconds); the ticker expects the scan's drops and learns the bisections' as they
+/// come.
+pub fn critical_rows_ticked(
+    base: &Scene,
+    mus: &[f64],
+    o: &CriticalOptions,
+    ticker: &Ticker,
+) -> Result<Vec<CriticalRow>, InvalidParameter> {
     check_mus(mus)?;
+    o.validate()?;
+    ticker.expect_more(mus.len() * o.scan_speeds().len());
     let drop_opts = DropOptions {
         duration_s: o.duration_s,
         ..Default::default()
@@ -552,10 +567,15 @@ pub fn critical_rows(
         s.validate()?;
     }
     let results = search_all(
-        |j, speed| drop_outcome(&scenes[j], speed, &drop_opts),
+        |j, speed| {
+            let outcome = drop_outcome(&scenes[j], speed, &drop_opts);
+            ticker.tick();
+            outcome
+        },
         scenes.len(),
         o,
     )?;
+    ticker.finish();
     Ok(results
         .into_iter()
         .zip(mus.iter().zip(&scenes))

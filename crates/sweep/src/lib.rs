@@ -39,6 +39,7 @@ pub mod merge;
 pub mod ordered;
 pub mod overrides;
 pub mod pool;
+pub mod progress;
 pub mod recheck;
 pub mod record;
 pub mod run;

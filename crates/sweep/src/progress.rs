@@ -1,0 +1,125 @@
+//! Progress of a phase whose drops take seconds (a critical search, the orbit drops):
+//! a spinner with a count on a terminal, a plain line every few seconds when standard
+//! error is not a terminal (a log file, a batch job), and nothing when switched off.
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// How often a plain progress line is written.
+const PLAIN_EVERY: Duration = Duration::from_secs(5);
+
+/// Counts finished drops of one phase and reports them; shared by the worker threads.
+pub struct Ticker {
+    label: String,
+    /// Drops known to be coming (a critical search learns its bisections as it goes).
+    expected: AtomicUsize,
+    done: AtomicUsize,
+    bar: Option<ProgressBar>,
+    plain: bool,
+    start: Instant,
+    last_line: Mutex<Instant>,
+}
+
+impl Ticker {
+    /// A ticker for `label` (`critical mu 0.25-0.5`) expecting `expected` drops, shown when
+    /// `on`: a bar on a terminal, else plain lines.
+    pub fn new(label: &str, expected: usize, on: bool) -> Self {
+        let tty = std::io::stderr().is_terminal();
+        let bar = (on && tty).then(|| {
+            let b =
+                ProgressBar::with_draw_target(Some(expected as u64), ProgressDrawTarget::stderr());
+            b.set_style(
+                ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} drops, ETA {eta}")
+                    .expect("valid template")
+                    .progress_chars("=> "),
+            );
+            b.set_message(label.to_string());
+            b
+        });
+        Self {
+            label: label.to_string(),
+            expected: AtomicUsize::new(expected),
+            done: AtomicUsize::new(0),
+            bar,
+            plain: on && !tty,
+            start: Instant::now(),
+            last_line: Mutex::new(Instant::now()),
+        }
+    }
+
+    /// A ticker that shows nothing.
+    pub fn off() -> Self {
+        Self::new("", 0, false)
+    }
+
+    /// `n` more drops are coming than were expected (bisection steps).
+    pub fn expect_more(&self, n: usize) {
+        let total = self.expected.fetch_add(n, Ordering::Relaxed) + n;
+        if let Some(b) = &self.bar {
+            b.set_length(total as u64);
+        }
+    }
+
+    /// One drop is done.
+    pub fn tick(&self) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        if done > self.expected.load(Ordering::Relaxed) {
+            self.expect_more(1);
+        }
+        if let Some(b) = &self.bar {
+            b.inc(1);
+        }
+        if self.plain {
+            let mut last = self.last_line.lock().unwrap_or_else(|e| e.into_inner());
+            if last.elapsed() >= PLAIN_EVERY {
+                *last = Instant::now();
+                crate::sweep::progress_line(&self.line());
+            }
+        }
+    }
+
+    /// Drops done so far.
+    pub fn done(&self) -> usize {
+        self.done.load(Ordering::Relaxed)
+    }
+
+    /// The plain progress line.
+    pub fn line(&self) -> String {
+        format!(
+            "{}: {} of {} drops, {:.0} s",
+            self.label,
+            self.done.load(Ordering::Relaxed),
+            self.expected.load(Ordering::Relaxed),
+            self.start.elapsed().as_secs_f64()
+        )
+    }
+
+    /// Clears the bar; a plain ticker that ran long enough to print writes its last line.
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+        if self.plain && self.start.elapsed() >= PLAIN_EVERY {
+            crate::sweep::progress_line(&self.line());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_past_the_expected_number_grow_it() {
+        let t = Ticker::off();
+        t.expect_more(2);
+        for _ in 0..3 {
+            t.tick();
+        }
+        assert_eq!(t.done(), 3);
+        assert!(t.line().contains("3 of 3 drops"), "{}", t.line());
+    }
+}
