@@ -101,6 +101,18 @@ def test_an_unknown_key_raises_and_lists_the_known_ones() -> None:
         whirlmap.drop(8000, 0.3, solver__race_atol=10)
 
 
+def test_a_solver_failure_is_a_simulation_error() -> None:
+    with pytest.raises(whirlmap.SimulationError, match=r"simulation failed \(step_budget\)"):
+        whirlmap.drop(8000, 0.3, duration_s=0.01, solver__max_step_attempts=10)
+    assert issubclass(whirlmap.SimulationError, RuntimeError)
+    # In a sweep the failure is recorded in its row instead.
+    rows = whirlmap.sweep(
+        {"duration_s": 0.01, "scene": {"solver": {"max_step_attempts": 10}},
+         "axes": {"mu": [0.3]}}
+    )  # fmt: skip
+    assert rows[0]["status"] == "failed" and rows[0]["error_kind"] == "step_budget"
+
+
 def test_default_scene_lists_the_override_keys() -> None:
     scene = whirlmap.default_scene()
     assert scene["speed_rpm"] == 8000
