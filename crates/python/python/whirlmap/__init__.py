@@ -1,0 +1,288 @@
+"""whirlmap: rotor drops onto AMB touchdown bearings, from Python.
+
+The same engine as the ``whirlmap`` command, built from the same Rust crates:
+
+- :func:`drop` runs one drop and returns its record (the JSON record of
+  ``whirlmap drop --json``, as a dict) and its time series as NumPy arrays;
+- :func:`critical` searches the critical speed of backward whirl per friction
+  coefficient (the rows of ``whirlmap critical --json``);
+- :func:`sweep` runs the grid of a sweep spec in memory and returns one flat row per
+  grid point, ready for ``pandas.DataFrame(rows)``.
+
+Scene parameters are keyword arguments named as the command line's ``--set`` keys; a
+dotted key is written with ``__`` for each dot (``solver__rtol=1e-7``) or passed as
+``**{"solver.rtol": 1e-7}``. A bad parameter raises ``ValueError`` naming the field,
+the value and the allowed range; a drop the solver cannot finish raises
+:class:`SimulationError`. The GIL is released while drops run, so Python threads run
+drops concurrently. See docs/python.md.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _whirlmap
+from ._whirlmap import MODEL_VERSION, SimulationError
+
+__all__ = [
+    "DropResult",
+    "MODEL_VERSION",
+    "SimulationError",
+    "critical",
+    "default_scene",
+    "drop",
+    "sweep",
+]
+
+#: The time series of a drop, in the order :attr:`DropResult.series` holds them.
+SERIES_NAMES: Tuple[str, ...] = (
+    "t_s",
+    "x_rotor_m",
+    "y_rotor_m",
+    "x_race_m",
+    "y_race_m",
+    "x_rel_m",
+    "y_rel_m",
+    "contact_force_n",
+    "slip_m_s",
+    "heat_power_w",
+    "rotor_speed_rad_s",
+    "race_speed_rad_s",
+)
+
+
+@dataclass(frozen=True)
+class DropResult:
+    """One drop's outputs.
+
+    Attributes:
+        record: The drop record, exactly the JSON object ``whirlmap drop --json`` prints
+            (``class``, ``max_contact_force_n``, ``energy``, ``features``,
+            ``model_version``, ...; docs/results-format.md#the-drop-record).
+        series: The recorded time series (``None`` when run with ``series=False``), each a
+            1-D float array of the same length, in increasing time: ``t_s`` (s since
+            release); the rotor centre ``x_rotor_m``, ``y_rotor_m`` and the race centre
+            ``x_race_m``, ``y_race_m`` relative to the housing (m, up is +y); the rotor
+            relative to the race ``x_rel_m``, ``y_rel_m`` (m: the Fig. 3 view, inside the
+            clearance circle); ``contact_force_n`` (N); ``slip_m_s``, the slip velocity at
+            the contact (m/s, zero while it rolls); ``heat_power_w`` (W); and both spins
+            ``rotor_speed_rad_s``, ``race_speed_rad_s`` (rad/s).
+        clearance_m: The radial clearance (m): the radius of the clearance circle.
+        scene: The scene that ran, as a dict (the JSON of ``whirlmap scene``).
+    """
+
+    record: Dict[str, Any]
+    series: Optional[Dict[str, np.ndarray]]
+    clearance_m: float
+    scene: Dict[str, Any]
+
+
+def _json_default(value: Any) -> Any:
+    """JSON for NumPy scalars and arrays (``np.float64(0.3)``, ``np.array([0, 1e-5])``)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"not a JSON value: {value!r}")
+
+
+def _overrides(overrides: Mapping[str, Any]) -> List[Tuple[str, str]]:
+    """Scene overrides as ``(dotted key, value as JSON text)`` pairs, in the order given."""
+    return [
+        (key.replace("__", "."), json.dumps(value, default=_json_default))
+        for key, value in overrides.items()
+    ]
+
+
+def default_scene() -> Dict[str, Any]:
+    """The default (paper) scene as a dict: every key a scene override may name.
+
+    Returns:
+        The JSON of ``whirlmap scene``, parsed.
+    """
+    return json.loads(_whirlmap.default_scene())
+
+
+def drop(
+    speed_rpm: Optional[float] = None,
+    mu: Optional[float] = None,
+    *,
+    duration_s: float = 1.0,
+    fidelity: Optional[str] = None,
+    series: bool = True,
+    series_points: int = 20_000,
+    **overrides: Any,
+) -> DropResult:
+    """Simulate one drop, as ``whirlmap drop`` does.
+
+    The scene is the paper's, then each override in the order given, then ``speed_rpm``
+    and ``mu``; it is validated, then the fidelity preset is applied.
+
+    Args:
+        speed_rpm: Rotor speed at release (r/min); ``None``: the scene's (8000).
+        mu: Dynamic friction coefficient rotor-race, in [0, 2] (the scene's
+            ``mu_dynamic``); ``None``: the scene's (0.1).
+        duration_s: Simulated time after release (s), in (0, 3600]; a drop whose class
+            has not settled is extended (scene ``classification.max_extension_s``).
+        fidelity: ``"draft"``, ``"standard"`` or ``"reference"``: the numerics preset;
+            ``None``: the scene's own solver settings.
+        series: Record the time series (about ``series_points`` samples).
+        series_points: How many samples to keep, about, in [1, 1e7].
+        **overrides: Scene parameters by their ``--set`` key: ``clearance_m=2e-4``,
+            ``solver__rtol=1e-7`` (``__`` for each dot), ``friction_law="switched"``,
+            ``release_offset_m=[1e-5, 0]``, ``thermal={}``.
+
+    Returns:
+        The record, the time series, the clearance and the scene.
+
+    Raises:
+        ValueError: A bad parameter or option; the message names the field, the value and
+            the allowed range (or, for an unknown key, the known ones).
+        SimulationError: The solver failed (its kind and the simulated time are in the
+            message).
+    """
+    record, scene, arrays, clearance_m = _whirlmap.drop(
+        None if speed_rpm is None else float(speed_rpm),
+        None if mu is None else float(mu),
+        float(duration_s),
+        fidelity,
+        int(series_points) if series else None,
+        _overrides(overrides),
+    )
+    return DropResult(
+        record=json.loads(record),
+        series=None if arrays is None else {k: arrays[k] for k in SERIES_NAMES},
+        clearance_m=clearance_m,
+        scene=json.loads(scene),
+    )
+
+
+def critical(
+    mu: Union[float, Sequence[float]],
+    *,
+    from_rpm: float = 1000.0,
+    to_rpm: float = 30000.0,
+    resolution_rpm: float = 250.0,
+    tol_rpm: float = 25.0,
+    duration_s: float = 1.0,
+    fidelity: Optional[str] = None,
+    threads: Optional[int] = None,
+    **overrides: Any,
+) -> List[Dict[str, Any]]:
+    """Search the critical speed of backward whirl, as ``whirlmap critical`` does.
+
+    For each friction coefficient: a scan over every multiple of ``resolution_rpm`` in
+    ``[from_rpm, to_rpm]`` (and both ends), then a bisection of every class transition down
+    to ``tol_rpm`` (docs/critical-speed.md). With a ``fidelity`` preset, the onset bracket is
+    re-checked at the next tighter preset (the row's ``recheck``).
+
+    Args:
+        mu: One friction coefficient or several, each in [0, 2].
+        from_rpm: Lowest release speed searched (r/min), in [0, 1e6).
+        to_rpm: Highest release speed searched (r/min), in (from_rpm, 1e6].
+        resolution_rpm: Lattice step of the scan (r/min).
+        tol_rpm: Bisect each transition until its bracket is this narrow (r/min), at most
+            ``resolution_rpm``.
+        duration_s: Simulated time of each drop (s).
+        fidelity: ``"draft"``, ``"standard"`` or ``"reference"``, or ``None``.
+        threads: Worker threads; ``None``: one per core (or ``RAYON_NUM_THREADS``).
+        **overrides: Scene parameters, as for :func:`drop`.
+
+    Returns:
+        One dict per friction coefficient, in the order given: the ``CriticalRow`` schema
+        of a sweep's ``critical.json`` (``mu``, ``onset_rpm``, ``bracket_rpm``,
+        ``class_below``, ``class_above``, ``whirl_intervals_rpm``, ``converged``,
+        ``drops``, ``note``, ``scan``, ``bisections``, ...). ``pandas.DataFrame(rows)``
+        reads them.
+
+    Raises:
+        ValueError: A bad option, friction coefficient or scene parameter (named, with its
+            value and allowed range); nothing has run.
+    """
+    mus = [float(mu)] if np.isscalar(mu) else [float(m) for m in mu]  # type: ignore[union-attr]
+    text = _whirlmap.critical(
+        mus,
+        float(from_rpm),
+        float(to_rpm),
+        float(resolution_rpm),
+        float(tol_rpm),
+        float(duration_s),
+        fidelity,
+        _overrides(overrides),
+        threads,
+    )
+    return json.loads(text)
+
+
+def _flatten(prefix: str, value: Any, row: Dict[str, Any]) -> None:
+    """Adds ``value`` to ``row`` under ``prefix``, nested dicts as dotted column names."""
+    if isinstance(value, dict):
+        for key, inner in value.items():
+            _flatten(f"{prefix}.{key}" if prefix else key, inner, row)
+    else:
+        row.setdefault(prefix, value)
+
+
+def sweep(
+    spec: Union[Mapping[str, Any], str, "os.PathLike[str]"],
+    *,
+    threads: Optional[int] = None,
+    flat: bool = True,
+) -> List[Dict[str, Any]]:
+    """Run the grid of a sweep spec in memory; nothing is written.
+
+    Every grid point's scene is checked before any drop runs. Only the grid runs: the
+    spec's ``critical``, ``orbits``, ``probability`` and ``charts`` sections are checked but
+    not run (use :func:`critical` for the search).
+
+    Args:
+        spec: A sweep spec (docs/sweeps.md) as a dict, or the path of a sweep JSON file. A
+            dict may leave out ``name``.
+        threads: Worker threads; ``None``: one per core (or ``RAYON_NUM_THREADS``).
+        flat: Return flat rows (below); ``False``: the points' records as a sweep writes
+            them to ``points.jsonl`` (nested dicts).
+
+    Returns:
+        One row per grid point, in grid order (the first axis varying slowest). A flat row
+        holds ``index``, ``key``, ``status`` (``"ok"`` or ``"failed"``), the axis values by
+        axis name, ``duration_s``, ``model_version``, ``scene_hash``, ``error_kind`` and
+        ``error`` (``None`` when ok), and every field of the drop record, nested ones as
+        dotted names (``energy.residual_rel``, ``features.window.stats.contact_duty``); a
+        record field named as an axis keeps the axis value. ``pandas.DataFrame(rows)``
+        reads them.
+
+    Raises:
+        ValueError: The spec is unreadable or invalid (the message names the field, the
+            value and the allowed range); nothing has run.
+    """
+    if isinstance(spec, Mapping):
+        spec_dict = dict(spec)
+        spec_dict.setdefault("name", "python")
+        text = _whirlmap.sweep(json.dumps(spec_dict, default=_json_default), None, threads)
+    else:
+        text = _whirlmap.sweep(None, os.fspath(spec), threads)
+    points = json.loads(text)
+    if not flat:
+        return points
+    rows = []
+    for p in points:
+        error = p.get("error") or {}
+        row: Dict[str, Any] = {
+            "index": p["index"],
+            "key": p["key"],
+            "status": p["status"],
+            **p["inputs"],
+            "duration_s": p["duration_s"],
+            "model_version": p["model_version"],
+            "scene_hash": p["scene_hash"],
+            "error_kind": error.get("kind"),
+            "error": error.get("message"),
+        }
+        _flatten("", p.get("record") or {}, row)
+        rows.append(row)
+    return rows

@@ -1,0 +1,262 @@
+//! # whirlmap-python: the native module `whirlmap._whirlmap`
+//!
+//! The Python package `whirlmap` (`python/whirlmap/__init__.py`) is a thin typed layer over
+//! these functions; call those, not these. Everything a drop, a search or a sweep does is the
+//! Rust crates' own: the scene overrides are [`whirlmap_sweep::overrides::apply`], the
+//! checks are the scene's, the options' and the spec's own validation (their messages name
+//! the field, the value and the allowed range and become a Python `ValueError`), drops run
+//! through [`whirlmap_sweep::run::run_drop`], critical searches through
+//! [`whirlmap_sweep::critical::critical_rows`] and sweep points through
+//! [`whirlmap_sweep::sweep::run_case`].
+//!
+//! Records cross the boundary as JSON text (parsed by the Python layer), so every field the
+//! records gain reaches Python unchanged; time series cross as NumPy arrays. Every
+//! simulation runs with the GIL released, so Python threads run drops concurrently.
+#![warn(missing_docs)]
+
+use numpy::IntoPyArray;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rayon::prelude::*;
+use serde_json::Value;
+use whirlmap_core::{DropOptions, Fidelity, Scene, MODEL_VERSION};
+use whirlmap_sweep::critical::{check_mus, critical_rows, CriticalOptions};
+use whirlmap_sweep::overrides::apply;
+use whirlmap_sweep::recheck::recheck_bracket;
+use whirlmap_sweep::record::DropRecord;
+use whirlmap_sweep::run::{run_drop, DropFailure};
+use whirlmap_sweep::spec::{self, SweepSpec};
+use whirlmap_sweep::sweep::run_case;
+
+pyo3::create_exception!(
+    _whirlmap,
+    SimulationError,
+    PyRuntimeError,
+    "A drop could not be integrated to its end: a typed solver error (its kind and the \
+     simulated time of the failure are in the message)."
+);
+
+/// A `ValueError` with `e`'s message.
+fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// A `SimulationError` for a failed drop, worded as the command line words it.
+fn simulation_error(e: DropFailure) -> PyErr {
+    SimulationError::new_err(format!("simulation failed ({}): {e}", e.kind()))
+}
+
+/// The rayon pool for `threads` (`None`: rayon's default).
+fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
+    if threads == Some(0) {
+        return Err(value_error("invalid threads = 0: allowed >= 1 (or None)"));
+    }
+    whirlmap_sweep::pool::pool(threads).map_err(|e| value_error(format!("threads: {e}")))
+}
+
+/// The paper's scene with `overrides` applied in order, each `(key, value as JSON text)`;
+/// a value that is not JSON is taken as a string, as `--set` takes it. An override error
+/// names the key and the value.
+fn scene_with(overrides: &[(String, String)]) -> PyResult<Scene> {
+    let mut scene = Scene::paper();
+    for (key, text) in overrides {
+        let value: Value = serde_json::from_str(text.trim())
+            .unwrap_or_else(|_| Value::String(text.trim().to_string()));
+        apply(&mut scene, key, value).map_err(|e| value_error(format!("{key}={text}: {e}")))?;
+    }
+    Ok(scene)
+}
+
+/// A fidelity preset by name, or `None`.
+fn fidelity(name: Option<&str>) -> PyResult<Option<Fidelity>> {
+    name.map(|n| Fidelity::parse(n).map_err(value_error))
+        .transpose()
+}
+
+/// The default (paper) scene as JSON text: every key an override may name.
+#[pyfunction]
+fn default_scene() -> String {
+    serde_json::to_string(&Scene::paper()).expect("a scene serialises")
+}
+
+/// One drop, as `whirlmap drop` runs it: the paper's scene, the overrides, then `speed_rpm`
+/// and `mu` (set as `mu_dynamic`), validated, then the fidelity preset. Returns the drop
+/// record and the scene as JSON text, and, when `series_points` is given, the recorded time
+/// series as a dict of NumPy arrays and the clearance (m).
+#[pyfunction]
+#[pyo3(signature = (speed_rpm, mu, duration_s, fidelity_name, series_points, overrides))]
+#[pyo3(name = "drop")]
+#[allow(clippy::type_complexity)]
+fn drop_one<'py>(
+    py: Python<'py>,
+    speed_rpm: Option<f64>,
+    mu: Option<f64>,
+    duration_s: f64,
+    fidelity_name: Option<String>,
+    series_points: Option<usize>,
+    overrides: Vec<(String, String)>,
+) -> PyResult<(String, String, Option<Bound<'py, PyDict>>, f64)> {
+    let mut scene = scene_with(&overrides)?;
+    if let Some(v) = speed_rpm {
+        scene.speed_rpm = v;
+    }
+    if let Some(v) = mu {
+        scene.mu_dynamic = v;
+    }
+    scene.validate().map_err(value_error)?;
+    if let Some(f) = fidelity(fidelity_name.as_deref())? {
+        f.apply(&mut scene);
+    }
+    let opts = DropOptions {
+        duration_s,
+        orbit_points: series_points,
+        ..Default::default()
+    };
+    opts.validate().map_err(value_error)?;
+    let report = py
+        .detach(|| run_drop(&scene, &opts))
+        .map_err(simulation_error)?;
+    let record =
+        serde_json::to_string(&DropRecord::from_report(&report)).expect("records serialise");
+    let scene_json = serde_json::to_string(&scene).expect("a scene serialises");
+    let Some(orbit) = report.orbit.filter(|_| series_points.is_some()) else {
+        return Ok((record, scene_json, None, scene.clearance_m));
+    };
+    let s = &orbit.samples;
+    let column = |f: fn(&whirlmap_core::orbit::OrbitSample) -> f64| -> Vec<f64> {
+        s.iter().map(f).collect()
+    };
+    let series = PyDict::new(py);
+    let columns: [(&str, Vec<f64>); 12] = [
+        ("t_s", column(|p| p.t_s)),
+        ("x_rotor_m", column(|p| p.x_race_m + p.x_rel_m)),
+        ("y_rotor_m", column(|p| p.y_race_m + p.y_rel_m)),
+        ("x_race_m", column(|p| p.x_race_m)),
+        ("y_race_m", column(|p| p.y_race_m)),
+        ("x_rel_m", column(|p| p.x_rel_m)),
+        ("y_rel_m", column(|p| p.y_rel_m)),
+        ("contact_force_n", column(|p| p.contact_force_n)),
+        ("slip_m_s", column(|p| p.slip_m_s)),
+        ("heat_power_w", column(|p| p.heat_power_w)),
+        ("rotor_speed_rad_s", column(|p| p.rotor_speed_rad_s)),
+        ("race_speed_rad_s", column(|p| p.race_speed_rad_s)),
+    ];
+    for (name, values) in columns {
+        series.set_item(name, values.into_pyarray(py))?;
+    }
+    Ok((record, scene_json, Some(series), orbit.clearance_m))
+}
+
+/// The critical speed of backward whirl for each friction coefficient in `mus`, as
+/// `whirlmap critical` searches it (the same rows, as JSON text). Everything is checked
+/// before any drop runs.
+#[pyfunction]
+#[pyo3(signature = (mus, from_rpm, to_rpm, resolution_rpm, tol_rpm, duration_s, fidelity_name, overrides, threads))]
+#[allow(clippy::too_many_arguments)]
+fn critical(
+    py: Python<'_>,
+    mus: Vec<f64>,
+    from_rpm: f64,
+    to_rpm: f64,
+    resolution_rpm: f64,
+    tol_rpm: f64,
+    duration_s: f64,
+    fidelity_name: Option<String>,
+    overrides: Vec<(String, String)>,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let opts = CriticalOptions {
+        from_rpm,
+        to_rpm,
+        resolution_rpm,
+        tol_rpm,
+        duration_s,
+    };
+    opts.validate().map_err(value_error)?;
+    check_mus(&mus).map_err(value_error)?;
+    let mut base = scene_with(&overrides)?;
+    base.validate().map_err(value_error)?;
+    let preset = fidelity(fidelity_name.as_deref())?;
+    if let Some(f) = preset {
+        f.apply(&mut base);
+    }
+    for &mu in &mus {
+        let mut s = base.clone();
+        s.mu_dynamic = mu;
+        s.validate()
+            .map_err(|e| value_error(format!("with mu {mu}: {e}")))?;
+    }
+    let pool = pool(threads)?;
+    let rows = py.detach(|| {
+        pool.install(|| {
+            let mut rows = critical_rows(&base, &mus, &opts)?;
+            if let Some(tighter) = preset.and_then(|f| f.tighter()) {
+                let drop_opts = DropOptions {
+                    duration_s,
+                    ..Default::default()
+                };
+                for row in rows.iter_mut() {
+                    let mut s = base.clone();
+                    s.mu_dynamic = row.mu;
+                    row.recheck = recheck_bracket(&s, row, tighter, &drop_opts);
+                }
+            }
+            Ok::<_, whirlmap_core::InvalidParameter>(rows)
+        })
+    });
+    let rows = rows.map_err(value_error)?;
+    Ok(serde_json::to_string(&rows).expect("rows serialise"))
+}
+
+/// Runs the grid of a sweep spec in memory (nothing is written): the spec is JSON text, or
+/// read from `path` when `text` is `None`. Every grid point's scene is checked before any
+/// drop runs. Returns the points' records (the lines of a sweep's `points.jsonl`, in grid
+/// order) as a JSON list. Only the grid runs: a spec's `critical`, `orbits`, `probability`
+/// and `charts` sections are read and checked but not run.
+#[pyfunction]
+#[pyo3(signature = (text, path, threads))]
+fn sweep(
+    py: Python<'_>,
+    text: Option<String>,
+    path: Option<String>,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let spec: SweepSpec = match (text, path) {
+        (Some(t), _) => {
+            let s = spec::parse(&t).map_err(|e| value_error(format!("sweep spec: {e}")))?;
+            s.validate().map_err(value_error)?;
+            s
+        }
+        (None, Some(p)) => spec::read(&p).map_err(value_error)?,
+        (None, None) => return Err(value_error("a sweep spec (text or path) is required")),
+    };
+    spec.check_points().map_err(value_error)?;
+    let grid = spec.grid().map_err(value_error)?;
+    let pool = pool(threads)?;
+    let records = py.detach(|| {
+        pool.install(|| {
+            (0..grid.len())
+                .into_par_iter()
+                .map(|i| {
+                    let point = grid.point(i).expect("every point was checked");
+                    run_case(&point, spec.duration_s)
+                })
+                .collect::<Vec<_>>()
+        })
+    });
+    Ok(serde_json::to_string(&records).expect("records serialise"))
+}
+
+/// The native module: `drop`, `critical`, `sweep`, `default_scene`, `SimulationError` and
+/// `MODEL_VERSION`.
+#[pymodule]
+fn _whirlmap(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(drop_one, m)?)?;
+    m.add_function(wrap_pyfunction!(critical, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(default_scene, m)?)?;
+    m.add("SimulationError", m.py().get_type::<SimulationError>())?;
+    m.add("MODEL_VERSION", MODEL_VERSION)?;
+    Ok(())
+}

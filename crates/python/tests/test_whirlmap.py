@@ -1,0 +1,211 @@
+"""Tests of the Python package: records, time series, errors, searches, sweeps, threads."""
+
+from __future__ import annotations
+
+import json
+import math
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import whirlmap
+
+CLASSES = {"pendulum", "bouncing", "backward_whirl", "forward_whirl", "unresolved"}
+
+
+@pytest.fixture(scope="module")
+def whirl_drop() -> whirlmap.DropResult:
+    """A short drop at 8000 r/min, mu 0.4: backward whirl (the onset is near 4500 r/min)."""
+    return whirlmap.drop(8000, 0.4, duration_s=0.3)
+
+
+def test_record_fields(whirl_drop: whirlmap.DropResult) -> None:
+    rec = whirl_drop.record
+    assert rec["class"] in CLASSES
+    assert rec["class"] == "backward_whirl"
+    assert rec["model_version"] == whirlmap.MODEL_VERSION >= 5
+    force = rec["max_contact_force_n"]
+    assert math.isfinite(force) and force > 0
+    assert rec["max_contact_force_n"] >= rec["first_contact_force_n"] > 0
+    assert rec["energy"]["residual_rel"] < 0.5
+    assert len(rec["scene_hash"]) == 16
+    assert whirl_drop.scene["mu_dynamic"] == 0.4
+    assert whirl_drop.scene["speed_rpm"] == 8000
+
+
+def test_series_arrays(whirl_drop: whirlmap.DropResult) -> None:
+    s = whirl_drop.series
+    assert s is not None
+    assert set(s) == set(whirlmap.SERIES_NAMES)
+    n = len(s["t_s"])
+    assert n > 100
+    for name, a in s.items():
+        assert isinstance(a, np.ndarray) and a.dtype == np.float64 and a.shape == (n,), name
+        assert np.all(np.isfinite(a)), name
+    t = s["t_s"]
+    assert np.all(np.diff(t) > 0), "time increases"
+    assert t[-1] <= whirl_drop.record["end_time_s"] + 1e-12
+    # The rotor is the race plus the rotor relative to it; it stays near the clearance circle.
+    np.testing.assert_allclose(s["x_rotor_m"], s["x_race_m"] + s["x_rel_m"])
+    np.testing.assert_allclose(s["y_rotor_m"], s["y_race_m"] + s["y_rel_m"])
+    r = np.hypot(s["x_rel_m"], s["y_rel_m"])
+    assert r.max() < 1.1 * whirl_drop.clearance_m
+    assert np.all(s["contact_force_n"] >= 0)
+    assert s["contact_force_n"].max() <= whirl_drop.record["max_contact_force_n"] * (1 + 1e-9)
+
+
+def test_no_series_and_the_same_record() -> None:
+    a = whirlmap.drop(6000, 0.2, duration_s=0.1, series=False)
+    b = whirlmap.drop(6000, 0.2, duration_s=0.1)
+    assert a.series is None
+    assert a.record == b.record
+
+
+def test_overrides_reach_the_scene() -> None:
+    r = whirlmap.drop(
+        4000, 0.1, duration_s=0.05, series=False, clearance_m=2e-4, solver__rtol=1e-6
+    )
+    assert r.scene["clearance_m"] == 2e-4
+    assert r.scene["solver"]["rtol"] == 1e-6
+    assert r.clearance_m == 2e-4
+    same = whirlmap.drop(
+        4000, 0.1, duration_s=0.05, series=False, **{"clearance_m": 2e-4, "solver.rtol": 1e-6}
+    )
+    assert same.record == r.record
+    assert whirlmap.drop(4000, 0.1, duration_s=0.05, series=False).record != r.record
+
+
+def test_a_bad_value_names_the_field_value_and_range() -> None:
+    with pytest.raises(ValueError) as e:
+        whirlmap.drop(8000, 0.3, duration_s=0.1, clearance_m=-1)
+    msg = str(e.value)
+    assert "clearance_m" in msg and "-1" in msg and "allowed" in msg, msg
+    with pytest.raises(ValueError, match=r"mu_dynamic = 2\.5: allowed \[0, 2\]"):
+        whirlmap.drop(8000, 2.5)
+    with pytest.raises(ValueError, match=r"duration_s = -1: allowed"):
+        whirlmap.drop(8000, 0.3, duration_s=-1)
+    with pytest.raises(ValueError, match="solver.rtol"):
+        whirlmap.drop(8000, 0.3, solver__rtol="tight")
+    with pytest.raises(ValueError, match="fidelity = fast"):
+        whirlmap.drop(8000, 0.3, fidelity="fast")
+
+
+def test_an_unknown_key_raises_and_lists_the_known_ones() -> None:
+    with pytest.raises(ValueError) as e:
+        whirlmap.drop(8000, 0.3, clearence_m=1e-4)
+    msg = str(e.value)
+    assert "clearence_m" in msg and "clearance_m" in msg, msg
+    with pytest.raises(ValueError, match="race_atol_scale"):
+        whirlmap.drop(8000, 0.3, solver__race_atol=10)
+
+
+def test_a_solver_failure_is_a_simulation_error() -> None:
+    with pytest.raises(whirlmap.SimulationError, match=r"simulation failed \(step_budget\)"):
+        whirlmap.drop(8000, 0.3, duration_s=0.01, solver__max_step_attempts=10)
+    assert issubclass(whirlmap.SimulationError, RuntimeError)
+    # In a sweep the failure is recorded in its row instead.
+    rows = whirlmap.sweep(
+        {"duration_s": 0.01, "scene": {"solver": {"max_step_attempts": 10}},
+         "axes": {"mu": [0.3]}}
+    )  # fmt: skip
+    assert rows[0]["status"] == "failed" and rows[0]["error_kind"] == "step_budget"
+
+
+def test_default_scene_lists_the_override_keys() -> None:
+    scene = whirlmap.default_scene()
+    assert scene["speed_rpm"] == 8000
+    assert "rtol" in scene["solver"]
+
+
+def test_critical_rows() -> None:
+    rows = whirlmap.critical(
+        [0.4, 0.1],
+        from_rpm=2000,
+        to_rpm=8000,
+        resolution_rpm=1000,
+        tol_rpm=500,
+        duration_s=0.5,
+        fidelity="draft",
+    )
+    assert [r["mu"] for r in rows] == [0.4, 0.1]
+    keys = {
+        "mu", "onset_rpm", "bracket_rpm", "class_below", "class_above",
+        "whirl_intervals_rpm", "whirl_at_range_top", "non_monotone", "drops",
+        "failed_drops", "converged", "from_rpm", "to_rpm", "resolution_rpm", "tol_rpm",
+        "duration_s", "scene_hash", "model_version", "note", "scan", "bisections",
+    }  # fmt: skip
+    for r in rows:
+        assert keys <= set(r), keys - set(r)
+        assert r["failed_drops"] == 0
+    onset = rows[0]["onset_rpm"]
+    assert onset is not None and 2000 < onset < 8000
+    lo, hi = rows[0]["bracket_rpm"]
+    assert lo < onset <= hi and hi - lo <= 500
+    assert rows[0]["class_above"] == "backward_whirl"
+    assert rows[0]["recheck"]["fidelity"] == "standard"
+    assert rows[1]["onset_rpm"] is None, "mu 0.1 does not whirl"
+    json.dumps(rows)  # plain JSON types only
+
+
+def test_critical_checks_before_running() -> None:
+    with pytest.raises(ValueError, match="to_rpm"):
+        whirlmap.critical(0.4, from_rpm=5000, to_rpm=4000)
+    with pytest.raises(ValueError, match="mu"):
+        whirlmap.critical(3.0, from_rpm=1000, to_rpm=2000)
+    with pytest.raises(ValueError, match="clearence_m"):
+        whirlmap.critical(0.4, from_rpm=1000, to_rpm=2000, clearence_m=1e-4)
+
+
+SPEC = {
+    "duration_s": 0.1,
+    "fidelity": "draft",
+    "axes": {"speed_rpm": [3000, 6000], "mu": [0.1, 0.3, 0.4]},
+}
+
+
+def test_sweep_rows(tmp_path: Path) -> None:
+    rows = whirlmap.sweep(SPEC, threads=2)
+    assert len(rows) == 2 * 3
+    assert [r["index"] for r in rows] == list(range(6))
+    assert [(r["speed_rpm"], r["mu"]) for r in rows] == [
+        (s, m) for s in (3000, 6000) for m in (0.1, 0.3, 0.4)
+    ]
+    for r in rows:
+        assert r["status"] == "ok" and r["error"] is None
+        assert r["class"] in CLASSES
+        assert r["max_contact_force_n"] > 0
+        assert r["energy.residual_rel"] < 0.5
+        assert not any(isinstance(v, dict) for v in r.values()), "flat rows"
+    # A spec file gives the same records, and nothing is written beside it.
+    path = tmp_path / "tiny.json"
+    path.write_text(json.dumps({"name": "tiny", **SPEC}))
+    nested = whirlmap.sweep(path, flat=False)
+    assert nested == whirlmap.sweep(SPEC, flat=False)
+    assert [p["record"]["class"] for p in nested] == [r["class"] for r in rows]
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["tiny.json"]
+
+
+def test_a_bad_sweep_spec_raises() -> None:
+    with pytest.raises(ValueError, match=r"axes.mu = 3|friction coefficient"):
+        whirlmap.sweep({**SPEC, "axes": {"mu": [3.0]}})
+    with pytest.raises(ValueError, match="clearence_m"):
+        whirlmap.sweep({**SPEC, "axes": {"clearence_m": [1e-4]}})
+    with pytest.raises(ValueError, match="cannot read"):
+        whirlmap.sweep("/nonexistent/spec.json")
+
+
+def test_threads_run_drops_concurrently() -> None:
+    """Two Python threads run drops at the same time (the GIL is released while a drop runs)
+    and get the same records as one thread does."""
+    cases = [(5000 + 500 * i, 0.1 * (i % 5)) for i in range(8)]
+    serial = [whirlmap.drop(s, m, duration_s=0.1, series=False).record for s, m in cases]
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        threaded = list(
+            pool.map(
+                lambda c: whirlmap.drop(c[0], c[1], duration_s=0.1, series=False).record,
+                cases,
+            )
+        )
+    assert threaded == serial
