@@ -98,3 +98,47 @@ fn design_charts_render_with_no_system_fonts() {
         assert!(svg.contains("r/min"), "{name}.svg lacks its axis unit");
     }
 }
+
+/// A sweep whose spec lists two charts gets those two and no third.
+#[test]
+fn a_sweep_draws_only_the_charts_its_spec_lists() {
+    let dir = temp_dir("two-charts");
+    let spec = dir.join("spec.json");
+    std::fs::write(
+        &spec,
+        r#"{"name": "two-charts", "duration_s": 0.05,
+            "axes": {"speed_rpm": [4000, 8000], "mu": [0.1, 0.4]},
+            "charts": ["max_force", "classes"]}"#,
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = whirlmap(&[
+        "sweep".as_ref(),
+        spec.as_os_str(),
+        "--out".as_ref(),
+        out_dir.as_os_str(),
+        "--no-progress".as_ref(),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let mut charts: Vec<String> = std::fs::read_dir(out_dir.join("charts"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    charts.sort();
+    assert_eq!(
+        charts,
+        [
+            "classes.png",
+            "classes.svg",
+            "fig5_max_force.png",
+            "fig5_max_force.svg"
+        ]
+    );
+    // render redraws the same two
+    let out = whirlmap(&["render".as_ref(), out_dir.as_os_str()]);
+    assert!(out.status.success(), "{out:?}");
+    assert_eq!(
+        std::fs::read_dir(out_dir.join("charts")).unwrap().count(),
+        4
+    );
+}

@@ -39,6 +39,8 @@ pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
         .disable_mesh()
         .disable_x_axis()
         .y_labels(8)
+        // Ticks outside the bar, so a label never touches a contour level's line.
+        .set_tick_mark_size(LabelAreaPosition::Right, 6)
         .y_label_formatter(&fmt)
         .y_desc(label)
         .label_style(text_style(TICK_FONT))

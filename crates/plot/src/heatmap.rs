@@ -52,6 +52,9 @@ pub(crate) enum CellKind {
     Empty,
     Failed,
     Whirl(OrbitClass),
+    /// A drop that had not settled at its extension cap: its peaks are not those of a
+    /// settled motion, so they stay out of the scale.
+    Unresolved,
     Value(f64),
     Class(OrbitClass),
     NoValue,
@@ -89,6 +92,7 @@ impl GridFigure<'_> {
         match self.mode {
             GridMode::Classes | GridMode::MarkedClasses(_) => CellKind::Class(class),
             GridMode::Metric(_) if class.is_whirl() => CellKind::Whirl(class),
+            GridMode::Metric(_) if class == OrbitClass::Unresolved => CellKind::Unresolved,
             GridMode::Metric(f) => {
                 f(row).map_or(CellKind::NoValue, |v| CellKind::Value(clamp_value(v)))
             }
@@ -153,7 +157,7 @@ impl Figure for GridFigure<'_> {
             (p.0 - base.0, p.1 - base.1)
         };
         let canvas = pa.strip_coord_spec();
-        let (mut any_failed, mut any_empty) = (false, false);
+        let (mut any_failed, mut any_empty, mut any_unresolved) = (false, false, false);
         let mut whirl_seen = [false, false];
         for j in 0..ny {
             for i in 0..nx {
@@ -175,6 +179,11 @@ impl Figure for GridFigure<'_> {
                         whirl_seen[forward as usize] = true;
                         canvas.draw(&Rectangle::new([tl, br], WHIRL_BG.filled()))?;
                         hatch(&canvas, tl, br, forward)?;
+                    }
+                    CellKind::Unresolved => {
+                        any_unresolved = true;
+                        let c = class_colour(OrbitClass::Unresolved);
+                        canvas.draw(&Rectangle::new([tl, br], c.filled()))?;
                     }
                     CellKind::Failed => {
                         any_failed = true;
@@ -284,6 +293,12 @@ impl Figure for GridFigure<'_> {
                     entries.push((
                         Mark::Hatch(true),
                         "forward whirl (not in scale)".to_string(),
+                    ));
+                }
+                if any_unresolved {
+                    entries.push((
+                        Mark::Swatch(class_colour(OrbitClass::Unresolved)),
+                        "unresolved (not settled; not in scale)".to_string(),
                     ));
                 }
                 if any_failed {

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use whirlmap_results::files::CHARTS_DIR;
-use whirlmap_results::files::POINTS_FILE;
+use whirlmap_results::files::{MANIFEST_FILE, POINTS_FILE};
 use whirlmap_results::grid::{assemble_grid, distinct_sorted};
 
 use crate::axes::CHART_SIZE;
@@ -28,12 +28,31 @@ pub(crate) fn write_both<F: Figure>(
     Ok(())
 }
 
+/// The charts a sweep's spec asks for (its `charts` list, as its manifest records it), by the
+/// spec's names (`orbits`, `critical`, `max_force`, `peak_power`, `classes`,
+/// `peak_temperature`); `None` when the folder has no manifest or the spec lists none: then
+/// every chart the data allows is drawn.
+fn wanted_charts(dir: &Path) -> Option<Vec<String>> {
+    #[derive(serde::Deserialize)]
+    struct Manifest {
+        spec: Option<Spec>,
+    }
+    #[derive(serde::Deserialize)]
+    struct Spec {
+        #[serde(default)]
+        charts: Vec<String>,
+    }
+    let text = std::fs::read_to_string(dir.join(MANIFEST_FILE)).ok()?;
+    let charts = serde_json::from_str::<Manifest>(&text).ok()?.spec?.charts;
+    (!charts.is_empty()).then_some(charts)
+}
+
 /// Draws every chart whose data exists in the results directory `dir` into `dir/charts/`, as
 /// PNG and SVG: `fig5_max_force`, `fig6_peak_power` and `classes` from `points.jsonl`
 /// (required), `peak_temperature` if the records carry temperatures, `fig4_critical` if
 /// `critical.json` exists, `fig3_orbits` if `orbits/` holds orbit files, `fig4_probability` if
-/// `contours.json` (an ensemble's) exists (then `points.jsonl` is optional). Returns the paths
-/// written.
+/// `contours.json` (an ensemble's) exists (then `points.jsonl` is optional). A sweep whose
+/// spec lists its `charts` gets only those. Returns the paths written.
 pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
     // An ensemble's results: Fig. 4 with probability bands (docs/probability.md).
     let prob = crate::probability::render_probability(dir)?;
@@ -50,14 +69,22 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         path: out_dir.clone(),
         cause,
     })?;
+    let wanted = wanted_charts(dir);
+    let wants = |name: &str| wanted.as_ref().is_none_or(|w| w.iter().any(|c| c == name));
     let mut written = Vec::new();
-    let fig5 = crate::fig5::figure(&grid);
-    write_both(&out_dir, "fig5_max_force", CHART_SIZE, &fig5, &mut written)?;
-    let fig6 = crate::fig6::figure(&grid);
-    write_both(&out_dir, "fig6_peak_power", CHART_SIZE, &fig6, &mut written)?;
-    let classes = crate::classes::figure(&grid);
-    write_both(&out_dir, "classes", CHART_SIZE, &classes, &mut written)?;
-    if rows.iter().any(|r| r.peak_temperature_k.is_some()) {
+    if wants("max_force") {
+        let fig5 = crate::fig5::figure(&grid);
+        write_both(&out_dir, "fig5_max_force", CHART_SIZE, &fig5, &mut written)?;
+    }
+    if wants("peak_power") {
+        let fig6 = crate::fig6::figure(&grid);
+        write_both(&out_dir, "fig6_peak_power", CHART_SIZE, &fig6, &mut written)?;
+    }
+    if wants("classes") {
+        let classes = crate::classes::figure(&grid);
+        write_both(&out_dir, "classes", CHART_SIZE, &classes, &mut written)?;
+    }
+    if wants("peak_temperature") && rows.iter().any(|r| r.peak_temperature_k.is_some()) {
         // Only records made with the thermal model carry temperatures.
         let temps = crate::peak_temperature::figure(&grid);
         write_both(
@@ -68,7 +95,7 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
             &mut written,
         )?;
     }
-    if let Some(rows) = &critical {
+    if let Some(rows) = critical.as_ref().filter(|_| wants("critical")) {
         let probability = load_probability(dir)?;
         let band = probability.as_ref().map(band_points);
         let label = probability.as_ref().map(|c| {
@@ -90,7 +117,7 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         };
         write_both(&out_dir, "fig4_critical", CHART_SIZE, &fig4, &mut written)?;
     }
-    if !orbits.is_empty() {
+    if !orbits.is_empty() && wants("orbits") {
         let speeds = distinct_sorted(orbits.iter().map(|o| o.speed_rpm));
         let title = match speeds.as_slice() {
             [s] => format!(

@@ -34,7 +34,14 @@ use whirlmap_core::scene::num;
 use whirlmap_core::{Fidelity, InvalidParameter, Scene};
 
 /// Chart names a spec may list.
-pub const CHART_NAMES: &[&str] = &["orbits", "critical", "max_force", "peak_power", "classes"];
+pub const CHART_NAMES: &[&str] = &[
+    "orbits",
+    "critical",
+    "max_force",
+    "peak_power",
+    "classes",
+    "peak_temperature",
+];
 
 /// Largest grid a spec may describe (points). The count is checked, with checked arithmetic,
 /// before any axis is built; larger grids are refused (exit 2).
