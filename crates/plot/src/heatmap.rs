@@ -224,6 +224,19 @@ impl Figure for GridFigure<'_> {
                     _ => f64::NAN,
                 })
                 .collect();
+            // A level just inside the range of the values cuts one corner of one cell: a
+            // stray dot, not a line. A level whose contour is shorter than 30 pixels in all
+            // is left out (here and on the colour bar).
+            levels.retain(|&level| {
+                let total: f64 = marching_squares(&g.speeds_rpm, &g.mus, &z, level)
+                    .iter()
+                    .map(|s| {
+                        let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
+                        (((p.0 - q.0).pow(2) + (p.1 - q.1).pow(2)) as f64).sqrt()
+                    })
+                    .sum();
+                total >= 30.0
+            });
             for &level in &levels {
                 let segs = marching_squares(&g.speeds_rpm, &g.mus, &z, level);
                 for s in &segs {

@@ -1,5 +1,5 @@
 //! The hottest node's peak temperature over release speed and friction (records made with
-//! the thermal model only).
+//! the thermal model only), in degrees Celsius as a designer reads it (records keep kelvin).
 
 use whirlmap_results::grid::Grid;
 
@@ -10,7 +10,7 @@ pub(crate) fn figure(grid: &Grid) -> GridFigure<'_> {
     GridFigure {
         grid,
         title: with_slice("Peak touchdown-bearing temperature", &grid.slice),
-        mode: GridMode::Metric(|r| r.peak_temperature_k),
-        bar_label: "hottest node peak temperature (K)",
+        mode: GridMode::Metric(|r| r.peak_temperature_k.map(|k| k - 273.15)),
+        bar_label: "hottest node peak temperature (\u{b0}C = K - 273.15)",
     }
 }

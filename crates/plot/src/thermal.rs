@@ -10,7 +10,8 @@ use whirlmap_core::thermal::network::NODES;
 use whirlmap_core::thermal::ThermalSample;
 
 use crate::render::{
-    draw_mesh, draw_thin_line, render, text_style, with_header, DrawResult, Figure, RenderError,
+    draw_mesh, draw_thin_line, render, text_style, tick_formatter, with_header, DrawResult,
+    Figure, RenderError, AXIS_COLOUR, AXIS_DESC_FONT, TICK_FONT,
 };
 
 /// Size (width, height) in pixels of the temperature figure.
@@ -39,7 +40,10 @@ const NODE_LABELS: [&str; NODES] = [
     "housing",
 ];
 
-/// Draws node temperatures (K), F_th (N) and the heat power (W) against time to `path` (`.png` or `.svg`).
+/// 0 deg C in kelvin.
+const KELVIN_AT_0_C: f64 = 273.15;
+
+/// Draws node temperatures (K, with deg C on the right axis), F_th (N) and the heat power (W) against time to `path` (`.png` or `.svg`).
 pub fn draw_temperatures(
     path: &Path,
     title: &str,
@@ -111,7 +115,10 @@ impl TemperatureFigure<'_> {
             .flat_map(|s| s.temperatures_k.iter().copied())
             .fold(f64::NEG_INFINITY, f64::max);
         let caption = if hottest.is_finite() {
-            format!("Node temperatures (hottest {hottest:.1} K)")
+            format!(
+                "Node temperatures (hottest {hottest:.1} K, {:.1} \u{b0}C)",
+                hottest - KELVIN_AT_0_C
+            )
         } else {
             "Node temperatures".to_string()
         };
@@ -125,11 +132,24 @@ impl TemperatureFigure<'_> {
         let mut chart = ChartBuilder::on(&area)
             .margin_top(8)
             .margin_left(20)
-            .margin_right(34)
+            .margin_right(8)
             .x_label_area_size(48)
             .y_label_area_size(78)
-            .build_cartesian_2d(t0..t1, y0..y1)?;
+            .right_y_label_area_size(78)
+            .build_cartesian_2d(t0..t1, y0..y1)?
+            .set_secondary_coord(t0..t1, (y0 - KELVIN_AT_0_C)..(y1 - KELVIN_AT_0_C));
         draw_mesh(&mut chart, "time (s)", "temperature (K)", 10, 8)?;
+        // The same scale in degrees Celsius on the right, as a designer reads it.
+        let c_fmt = tick_formatter(y1 - y0);
+        chart
+            .configure_secondary_axes()
+            .y_desc("temperature (\u{b0}C)")
+            .y_labels(8)
+            .y_label_formatter(&c_fmt)
+            .label_style(text_style(TICK_FONT))
+            .axis_desc_style(text_style(AXIS_DESC_FONT))
+            .axis_style(AXIS_COLOUR.stroke_width(1))
+            .draw()?;
         for k in 0..NODES {
             let pts: Vec<(f64, f64)> = self
                 .series
@@ -182,9 +202,11 @@ impl TemperatureFigure<'_> {
             .margin_top(8)
             .margin_bottom(6)
             .margin_left(20)
-            .margin_right(34)
+            .margin_right(8)
             .x_label_area_size(48)
             .y_label_area_size(78)
+            // Aligned with the temperature panel's right (deg C) axis.
+            .right_y_label_area_size(78)
             .build_cartesian_2d(t0..t1, lo.min(0.0)..hi.max(1.0))?;
         draw_mesh(&mut chart, "time (s)", y_desc, 10, 4)?;
         let pts: Vec<(f64, f64)> = self
