@@ -72,6 +72,24 @@ pub(crate) fn refuse_existing_results(
     )
 }
 
+/// Which file's schema `whirlmap schema` prints.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum SchemaKind {
+    /// A scene file (`--scene`).
+    Scene,
+    /// A sweep file (`whirlmap sweep FILE`).
+    Sweep,
+    /// An ensemble file (`whirlmap ensemble FILE`, `whirlmap adaptive FILE`).
+    Ensemble,
+}
+
+/// `whirlmap schema`'s options.
+#[derive(clap::Args)]
+struct SchemaArgs {
+    /// The kind of file.
+    kind: SchemaKind,
+}
+
 /// `whirlmap scene`'s options.
 #[derive(clap::Args)]
 struct SceneArgs {
@@ -126,6 +144,9 @@ enum Command {
     /// Print the default scene (the paper's) as JSON, every accepted field with its default:
     /// a starting file for --scene. Units, ranges and sources: `--schema`.
     Scene(SceneArgs),
+    /// Print the JSON Schema of a scene, sweep or ensemble file, for editors to validate
+    /// files against: type, default, unit, allowed range and source of every scene field.
+    Schema(SchemaArgs),
     /// Time a pendulum drop, a whirl drop and one right-hand-side evaluation.
     Bench(bench::BenchArgs),
     /// Draw the design charts (Figs. 3-6, class map) of a sweep's results directory into
@@ -480,6 +501,18 @@ fn run() -> u8 {
         Command::Drop(a) => run_drop(a),
         Command::Scene(a) => {
             outln!("{}", scene_text(a));
+            Ok(())
+        }
+        Command::Schema(a) => {
+            let schema = match a.kind {
+                SchemaKind::Scene => whirlmap_core::schema::scene_schema(),
+                SchemaKind::Sweep => whirlmap_sweep::schema::sweep_schema(),
+                SchemaKind::Ensemble => whirlmap_sweep::schema::ensemble_schema(),
+            };
+            outln!(
+                "{}",
+                serde_json::to_string_pretty(&schema).expect("a schema serialises")
+            );
             Ok(())
         }
         Command::Bench(a) => bench::run(a).map_err(Failure::Solve),

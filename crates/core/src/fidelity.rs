@@ -12,6 +12,7 @@ use crate::scene::{Method, Scene, SolverSettings};
 use serde::{Deserialize, Serialize};
 
 /// A named speed/accuracy trade-off.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {

@@ -10,8 +10,8 @@ use whirlmap_core::thermal::network::NODES;
 use whirlmap_core::thermal::ThermalSample;
 
 use crate::render::{
-    draw_mesh, draw_thin_line, render, text_style, tick_formatter, with_header, DrawResult,
-    Figure, RenderError, AXIS_COLOUR, AXIS_DESC_FONT, TICK_FONT,
+    draw_mesh, draw_thin_line, render, text_style, tick_formatter, with_header, DrawResult, Figure,
+    RenderError, AXIS_COLOUR, AXIS_DESC_FONT, TICK_FONT,
 };
 
 /// Size (width, height) in pixels of the temperature figure.

@@ -47,6 +47,7 @@ fn default_bounds() -> [f64; 2] {
 }
 
 /// The `adaptive` section of an ensemble file.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AdaptiveParams {

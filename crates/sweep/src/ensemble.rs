@@ -110,6 +110,7 @@ impl SplitMix64 {
 const MAX_REJECTIONS: usize = 100_000;
 
 /// A distribution declared in the file.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum Dist {
@@ -205,6 +206,7 @@ fn default_levels() -> Vec<f64> {
 }
 
 /// The `ensemble` section: members per cell, the seed and what is drawn.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnsembleParams {
@@ -237,6 +239,7 @@ pub struct EnsembleParams {
 }
 
 /// An ensemble (and adaptive) file: a sweep grid plus the `ensemble` and `adaptive` sections.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnsembleSpec {

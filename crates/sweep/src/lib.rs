@@ -43,6 +43,8 @@ pub mod progress;
 pub mod recheck;
 pub mod record;
 pub mod run;
+#[cfg(feature = "schema")]
+pub mod schema;
 pub mod shard;
 pub mod spec;
 pub mod sweep;

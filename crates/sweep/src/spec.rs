@@ -171,6 +171,7 @@ pub enum SpecError {
 }
 
 /// A closed interval (the critical-speed search range).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RangeSpec {
@@ -191,6 +192,7 @@ fn default_resolution_rpm() -> f64 {
 /// The critical-speed search ([`crate::critical`]): for each `mu`, the onset of sustained
 /// whirl and every whirl interval in `speed_rpm`, scanned on a lattice of `resolution_rpm`
 /// and bisected to `tol_rpm`.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CriticalSpec {
@@ -415,6 +417,7 @@ impl Serialize for Axes {
 }
 
 /// A parsed sweep spec.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
@@ -450,6 +453,7 @@ pub struct SweepSpec {
 }
 
 /// A sweep's probability ensemble ([`crate::ensemble`]): its grid and what each member draws.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProbabilitySpec {
@@ -489,6 +493,7 @@ impl SweepSpec {
 }
 
 /// The Fig. 3 panels: one drop per friction coefficient at one speed, orbit recorded.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OrbitsSpec {
@@ -1171,5 +1176,49 @@ mod tests {
         assert_eq!(e.exit_code(), 2);
         check_output_dir(&dir.join("out")).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[cfg(feature = "schema")]
+impl schemars::JsonSchema for AxisValues {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "AxisValues".into()
+    }
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        schemars::json_schema!({
+            "description": "The values of one axis: a list, in order, or `steps` evenly \
+                            spaced points from `from` to `to` (both included).",
+            "oneOf": [
+                {"type": "array", "items": {"type": "number"}, "minItems": 1},
+                {
+                    "type": "object",
+                    "properties": {
+                        "from": {"type": "number"},
+                        "to": {"type": "number"},
+                        "steps": {"type": "integer", "minimum": 1}
+                    },
+                    "required": ["from", "to", "steps"],
+                    "additionalProperties": false
+                }
+            ]
+        })
+    }
+}
+
+#[cfg(feature = "schema")]
+impl schemars::JsonSchema for Axes {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "Axes".into()
+    }
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let values = generator.subschema_for::<AxisValues>();
+        schemars::json_schema!({
+            "description": "Axis name (`speed_rpm`, `mu`, or any numeric scene field by dotted \
+                            key) -> its values; the grid is every combination, the first axis \
+                            varying slowest.",
+            "type": "object",
+            "minProperties": 1,
+            "additionalProperties": values
+        })
     }
 }
