@@ -938,6 +938,50 @@ pub fn check_output_dir(dir: &Path) -> Result<(), crate::sweep::SweepError> {
     }
 }
 
+#[cfg(feature = "schema")]
+impl schemars::JsonSchema for AxisValues {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "AxisValues".into()
+    }
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        schemars::json_schema!({
+            "description": "The values of one axis: a list, in order, or `steps` evenly \
+                            spaced points from `from` to `to` (both included).",
+            "oneOf": [
+                {"type": "array", "items": {"type": "number"}, "minItems": 1},
+                {
+                    "type": "object",
+                    "properties": {
+                        "from": {"type": "number"},
+                        "to": {"type": "number"},
+                        "steps": {"type": "integer", "minimum": 1}
+                    },
+                    "required": ["from", "to", "steps"],
+                    "additionalProperties": false
+                }
+            ]
+        })
+    }
+}
+
+#[cfg(feature = "schema")]
+impl schemars::JsonSchema for Axes {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "Axes".into()
+    }
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let values = generator.subschema_for::<AxisValues>();
+        schemars::json_schema!({
+            "description": "Axis name (`speed_rpm`, `mu`, or any numeric scene field by dotted \
+                            key) -> its values; the grid is every combination, the first axis \
+                            varying slowest.",
+            "type": "object",
+            "minProperties": 1,
+            "additionalProperties": values
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1176,49 +1220,5 @@ mod tests {
         assert_eq!(e.exit_code(), 2);
         check_output_dir(&dir.join("out")).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
-    }
-}
-
-#[cfg(feature = "schema")]
-impl schemars::JsonSchema for AxisValues {
-    fn schema_name() -> std::borrow::Cow<'static, str> {
-        "AxisValues".into()
-    }
-    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
-        schemars::json_schema!({
-            "description": "The values of one axis: a list, in order, or `steps` evenly \
-                            spaced points from `from` to `to` (both included).",
-            "oneOf": [
-                {"type": "array", "items": {"type": "number"}, "minItems": 1},
-                {
-                    "type": "object",
-                    "properties": {
-                        "from": {"type": "number"},
-                        "to": {"type": "number"},
-                        "steps": {"type": "integer", "minimum": 1}
-                    },
-                    "required": ["from", "to", "steps"],
-                    "additionalProperties": false
-                }
-            ]
-        })
-    }
-}
-
-#[cfg(feature = "schema")]
-impl schemars::JsonSchema for Axes {
-    fn schema_name() -> std::borrow::Cow<'static, str> {
-        "Axes".into()
-    }
-    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
-        let values = generator.subschema_for::<AxisValues>();
-        schemars::json_schema!({
-            "description": "Axis name (`speed_rpm`, `mu`, or any numeric scene field by dotted \
-                            key) -> its values; the grid is every combination, the first axis \
-                            varying slowest.",
-            "type": "object",
-            "minProperties": 1,
-            "additionalProperties": values
-        })
     }
 }
