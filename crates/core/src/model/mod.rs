@@ -19,6 +19,7 @@ mod jacobian;
 mod memo;
 pub mod modes;
 pub mod quasi_static;
+pub mod roots;
 mod state;
 
 use crate::ode::{OdeSystem, StiffJacobian, MAX_GUARDS};
