@@ -28,8 +28,8 @@ impl Palmgren {
     #[inline]
     pub fn viscous_torque_n_m(&self, omega_rad_s: f64) -> f64 {
         let x = self.nu0_mm2_s * omega_rad_s.abs() * RAD_S_TO_RPM;
-        // An inlined cube root (`super::roots`), within 1 ulp of `x.powf(2.0 / 3.0)`.
-        let x23 = super::roots::pow_2_3(x);
+        // powf rather than cbrt: Rust's cbrt is a slow software routine (see hertz.rs).
+        let x23 = x.powf(2.0 / 3.0);
         1e-7 * self.f0 * x23.max(160.0) * self.dm_mm.powi(3) * 1e-3
     }
 
@@ -42,8 +42,7 @@ impl Palmgren {
         if p == 0.0 {
             return 0.0;
         }
-        // An inlined power (`super::roots`), within 2 ulp of `(p / c0)^0.33`.
-        let f1 = 0.001 * super::roots::pow_0_33(p / self.c0_n);
+        let f1 = 0.001 * (p / self.c0_n).powf(0.33);
         f1 * p * self.dm_mm * 1e-3
     }
 

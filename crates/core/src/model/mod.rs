@@ -19,7 +19,6 @@ mod jacobian;
 mod memo;
 pub mod modes;
 pub mod quasi_static;
-pub mod roots;
 mod state;
 
 use crate::ode::{OdeSystem, StiffJacobian, MAX_GUARDS};
