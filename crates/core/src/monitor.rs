@@ -459,7 +459,10 @@ impl Monitor {
                 1 => &mut self.max_hs,
                 _ => &mut self.max_h,
             };
-            if vmax <= peak.value {
+            // No sample beats the peak: nothing to refine, unless the peak is this step's
+            // start (a step end where the quantity was still rising), whose maximum can lie
+            // inside this step although both later samples are lower.
+            if vmax <= peak.value && !(imax == 0 && peak.time_s == ts[0]) {
                 continue;
             }
             // Bracket around the best sample and refine on the interpolant.
