@@ -60,15 +60,7 @@ pub enum MergeError {
     Charts(#[from] ChartsFailed),
 }
 
-/// Why the chart drawing handed to [`merge`] failed, as its caller words it.
-#[derive(Debug, Error)]
-#[error("{message}")]
-pub struct ChartsFailed {
-    /// What went wrong.
-    pub message: String,
-    /// Whether an output could not be written (exit code 4) rather than an input read (2).
-    pub output: bool,
-}
+pub use crate::pipeline::ChartsFailed;
 
 impl MergeError {
     /// The process exit code: 2 refused or bad input, 4 an output failed.
@@ -251,7 +243,7 @@ pub fn merge(
     dirs: &[PathBuf],
     out_dir: &Path,
     overwrite: bool,
-    draw_charts: &dyn Fn(&Path) -> Result<Vec<PathBuf>, ChartsFailed>,
+    draw_charts: crate::pipeline::DrawCharts,
 ) -> Result<MergeOutcome, MergeError> {
     let shards = read_shards(dirs)?;
     let spec = shards[0].m.spec.clone();
@@ -624,11 +616,7 @@ pub fn merge(
     });
     record.classes = Some(classes.clone());
     write_manifest(&out, &record, false)?;
-    let charts = if spec.charts.is_empty() {
-        Vec::new()
-    } else {
-        draw_charts(out_dir)?
-    };
+    let charts = crate::pipeline::draw_charts(&spec, out_dir, draw_charts)?.unwrap_or_default();
     out.record_tree(CHARTS_DIR)?;
     record.meta.ended_unix_s = merged_end(&shards);
     write_manifest(&out, &record, true)?;
