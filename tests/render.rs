@@ -98,3 +98,43 @@ fn design_charts_render_with_no_system_fonts() {
         assert!(svg.contains("r/min"), "{name}.svg lacks its axis unit");
     }
 }
+
+#[test]
+fn render_redraws_an_ensemble_and_says_an_adaptive_map_has_no_charts() {
+    let results = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("results");
+    // An adaptive map: no charts to draw, said plainly, exit 0, the folder left as it was.
+    let adaptive = temp_dir("adaptive");
+    std::fs::copy(
+        results.join("adaptive-paper/adaptive.json"),
+        adaptive.join("adaptive.json"),
+    )
+    .unwrap();
+    let out = whirlmap(&["render".as_ref(), adaptive.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("no charts") && said.contains("adaptive"),
+        "{said}"
+    );
+    assert!(!adaptive.join("charts").exists());
+
+    // An ensemble: Fig. 4 with probability bands, as `whirlmap ensemble` drew it.
+    let ensemble = temp_dir("ensemble");
+    std::fs::copy(
+        results.join("ensemble-paper/contours.json"),
+        ensemble.join("contours.json"),
+    )
+    .unwrap();
+    let out = whirlmap(&["render".as_ref(), ensemble.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    for ext in ["png", "svg"] {
+        let drawn = std::fs::read(ensemble.join(format!("charts/fig4_probability.{ext}"))).unwrap();
+        let committed =
+            std::fs::read(results.join(format!("ensemble-paper/charts/fig4_probability.{ext}")))
+                .unwrap();
+        assert!(
+            drawn == committed,
+            "fig4_probability.{ext} differs from the committed one"
+        );
+    }
+}
