@@ -138,3 +138,30 @@ fn render_redraws_an_ensemble_and_says_an_adaptive_map_has_no_charts() {
         );
     }
 }
+
+/// Copies the folder `from` into `to`, recursively.
+fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            copy_tree(&p, &to.join(e.file_name()));
+        } else {
+            std::fs::copy(&p, to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+#[test]
+fn render_leaves_a_committed_manifest_as_it_was() {
+    // The charts come out the same, so the manifest (read and written as its typed form)
+    // must come out byte for byte the same too, its keys in the order the run wrote them.
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("results/paper-radial");
+    let dir = temp_dir("relist");
+    copy_tree(&src, &dir);
+    let out = whirlmap(&["render".as_ref(), dir.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let before = std::fs::read_to_string(src.join("manifest.json")).unwrap();
+    let after = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
+    assert!(before == after, "render rewrote manifest.json");
+}

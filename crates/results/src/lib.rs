@@ -9,6 +9,8 @@
 //! - [`critical`]: the rows of `critical.json` and `critical.csv`.
 //! - [`orbit`]: the recorded orbits of `orbits/`.
 //! - [`contours`]: an ensemble's `contours.json`.
+//! - [`manifest`]: `manifest.json` (a run's, tolerantly any folder's, an ensemble's) and
+//!   `timings.jsonl`.
 //! - [`grid`]: the points arranged over release speed and friction (the grid charts, a
 //!   comparison's changed cells).
 //! - [`read`]: JSON Lines that tolerate a torn last line, whole-file JSON, typed errors that
@@ -23,6 +25,7 @@ pub mod contours;
 pub mod critical;
 pub mod files;
 pub mod grid;
+pub mod manifest;
 pub mod orbit;
 pub mod point;
 pub mod read;

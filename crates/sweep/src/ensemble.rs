@@ -67,6 +67,7 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::Scene;
+use whirlmap_results::manifest::{EnsembleManifest, SortedKeys};
 
 /// Per-cell statistics as CSV.
 pub const CELLS_CSV: &str = "cells.csv";
@@ -972,20 +973,19 @@ pub fn run_ensemble_here(
         &mut written,
     )?;
     let failed = members.iter().filter(|m| m.class.is_none()).count();
-    let manifest = serde_json::json!({
-        "spec": spec,
-        "whirlmap_version": env!("CARGO_PKG_VERSION"),
-        "model_version": whirlmap_core::MODEL_VERSION,
-        "threads": rayon::current_num_threads(),
-        "cells": cells.len(),
-        "drops": members.len(),
-        "failed": failed,
-        "wall_time_s": start.elapsed().as_secs_f64(),
-    });
-    let text = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
+    let manifest = EnsembleManifest {
+        cells: cells.len(),
+        drops: members.len(),
+        failed,
+        model_version: whirlmap_core::MODEL_VERSION,
+        spec: SortedKeys(spec),
+        threads: rayon::current_num_threads(),
+        wall_time_s: start.elapsed().as_secs_f64(),
+        whirlmap_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
     write_file(
         &out_dir.join(MANIFEST_FILE),
-        &format!("{text}\n"),
+        &manifest.to_text(),
         &mut written,
     )?;
     Ok(EnsembleOutcome {

@@ -19,10 +19,10 @@
 use crate::spec::SweepSpec;
 use crate::sweep::{point_key, SweepError};
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
 use std::path::Path;
 use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::MODEL_VERSION;
+use whirlmap_results::manifest::ShardTag;
 
 /// The file a shard writes before it runs: [`ShardManifest`].
 pub use whirlmap_results::files::SHARD_FILE;
@@ -79,8 +79,11 @@ impl Shard {
     }
 
     /// The `shard` section of the shard's `manifest.json`.
-    pub fn manifest_tag(&self) -> Value {
-        json!({"index": self.index, "count": self.count})
+    pub fn manifest_tag(&self) -> ShardTag {
+        ShardTag {
+            count: self.count,
+            index: self.index,
+        }
     }
 }
 

@@ -37,7 +37,7 @@
 //! nothing the size of the grid is held but, on a resume, the records read back and those
 //! written since.
 
-use crate::folder::{self, FileEntry, Mode, RunFolder, RunIdentity};
+use crate::folder::{self, Mode, RunFolder, RunIdentity};
 use crate::ordered::{run_ordered, OrderedSink};
 use crate::record::DropRecord;
 use crate::run::{catch_drop, DropFailure};
@@ -55,6 +55,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use thiserror::Error;
 use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::{simulate, DropOptions, Scene, MODEL_VERSION};
+use whirlmap_results::manifest::{Manifest, MergedShard, ShardTag, TimingRow};
 use whirlmap_results::point::PointLine;
 
 pub use whirlmap_results::files::{MANIFEST_FILE, POINTS_FILE, SUMMARY_FILE, TIMINGS_FILE};
@@ -197,42 +198,7 @@ pub struct SweepOutcome {
     pub out_dir: PathBuf,
 }
 
-#[derive(Serialize)]
-struct Manifest<'a> {
-    spec: &'a SweepSpec,
-    /// [`crate::shard::spec_hash`] of `spec`.
-    spec_hash: &'a str,
-    whirlmap_version: &'a str,
-    model_version: u32,
-    /// The commit the binary that ran the drops was built from
-    /// ([`crate::build_info::GIT_COMMIT`]).
-    git_commit: &'a str,
-    /// False while the run is going on (or after it was killed); true once every file is
-    /// written.
-    complete: bool,
-    started_unix_s: f64,
-    ended_unix_s: Option<f64>,
-    threads: usize,
-    counts: Option<&'a Counts>,
-    classes: Option<&'a BTreeMap<String, usize>>,
-    /// A shard run's part of the grid (`crate::shard`); absent for a whole run.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    shard: Option<&'a Value>,
-    /// The shards a merged result was made from (`crate::merge`); absent otherwise.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    merged_from: Option<&'a Value>,
-    /// Every file the run wrote (relative path -> size and FNV-1a 64 hash).
-    files: &'a BTreeMap<String, FileEntry>,
-}
-
-/// The counts of a finished grid.
-#[derive(Debug, Clone, Serialize)]
-pub(crate) struct Counts {
-    pub points: usize,
-    pub ok: usize,
-    pub failed: usize,
-    pub skipped: usize,
-}
+pub(crate) use whirlmap_results::manifest::Counts;
 
 pub(crate) fn unix_now() -> f64 {
     SystemTime::now()
@@ -512,13 +478,13 @@ pub(crate) struct RunMeta {
     pub started_unix_s: f64,
     pub ended_unix_s: Option<f64>,
     pub threads: usize,
-    pub shard: Option<Value>,
-    pub merged_from: Option<Value>,
+    pub shard: Option<ShardTag>,
+    pub merged_from: Option<Vec<MergedShard>>,
 }
 
 impl RunMeta {
     /// This binary's build, started now.
-    pub fn now(threads: usize, shard: Option<Value>) -> Self {
+    pub fn now(threads: usize, shard: Option<ShardTag>) -> Self {
         Self {
             whirlmap_version: crate::build_info::VERSION.to_string(),
             git_commit: crate::build_info::GIT_COMMIT.to_string(),
@@ -549,24 +515,23 @@ pub(crate) fn write_manifest(
 ) -> Result<(), SweepError> {
     let manifest = Manifest {
         spec: &r.spec,
-        spec_hash: &r.spec_hash,
-        whirlmap_version: &r.meta.whirlmap_version,
+        spec_hash: r.spec_hash.clone(),
+        whirlmap_version: r.meta.whirlmap_version.clone(),
         model_version: MODEL_VERSION,
-        git_commit: &r.meta.git_commit,
+        git_commit: r.meta.git_commit.clone(),
         complete,
         started_unix_s: r.meta.started_unix_s,
         ended_unix_s: r.meta.ended_unix_s,
         threads: r.meta.threads,
-        counts: r.counts.as_ref(),
-        classes: r.classes.as_ref(),
-        shard: r.meta.shard.as_ref(),
-        merged_from: r.meta.merged_from.as_ref(),
-        files: folder.files(),
+        counts: r.counts.clone(),
+        classes: r.classes.clone(),
+        shard: r.meta.shard,
+        merged_from: r.meta.merged_from.clone(),
+        files: folder.files().clone(),
     };
-    let text = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
     folder::write_atomic(
         &folder.dir().join(MANIFEST_FILE),
-        format!("{text}\n").as_bytes(),
+        manifest.to_text().as_bytes(),
     )
 }
 
@@ -762,9 +727,13 @@ impl OrderedSink<GridJob> for GridWriter<'_> {
             let line = r.to_line();
             text.push_str(&line);
             text.push('\n');
-            let t =
-                serde_json::json!({"key": r.key, "index": r.index, "wall_time_s": r.wall_time_s});
-            times.push_str(&format!("{t}\n"));
+            let t = TimingRow {
+                index: r.index,
+                key: r.key.clone(),
+                wall_time_s: r.wall_time_s,
+            };
+            times.push_str(&t.to_line());
+            times.push('\n');
             if let Some(fresh) = &mut self.fresh {
                 fresh.insert(
                     r.key.clone(),
