@@ -9,6 +9,8 @@
 //! - [`critical`]: the rows of `critical.json` and `critical.csv`.
 //! - [`orbit`]: the recorded orbits of `orbits/`.
 //! - [`contours`]: an ensemble's `contours.json`.
+//! - [`ensemble`]: an ensemble's `members.jsonl` and `cells.jsonl`.
+//! - [`adaptive`]: `adaptive.json`, an adaptive refinement of the class map.
 //! - [`manifest`]: `manifest.json` (a run's, tolerantly any folder's, an ensemble's) and
 //!   `timings.jsonl`.
 //! - [`grid`]: the points arranged over release speed and friction (the grid charts, a
@@ -20,12 +22,15 @@
 //! No threads, no charts: this crate only knows the files.
 #![warn(missing_docs)]
 
+pub mod adaptive;
 pub mod atomic;
 pub mod contours;
 pub mod critical;
+pub mod ensemble;
 pub mod files;
 pub mod grid;
 pub mod manifest;
+mod nan;
 pub mod orbit;
 pub mod point;
 pub mod read;
