@@ -61,7 +61,6 @@ impl Reference for Decay {
 
 /// x'' = -x as a first-order system: cos t, -sin t. `wrong_jacobian` hands the implicit
 /// stepper a matrix that is not the Jacobian.
-#[derive(Clone, Copy)]
 struct Harmonic {
     wrong_jacobian: bool,
 }
@@ -230,33 +229,39 @@ fn methods() -> [Method; 3] {
     ]
 }
 
-/// The problems a method runs, with their names.
-fn problems(m: &Method) -> Vec<(&'static str, Box<dyn ReferenceDyn>, [f64; 2], f64)> {
-    let mut v: Vec<(&'static str, Box<dyn ReferenceDyn>, [f64; 2], f64)> = vec![
-        (
-            Decay.name(),
-            Box::new(Decay),
-            Decay.exact(Decay.t_end()),
-            Decay.t_end(),
-        ),
-        {
-            let h = Harmonic {
-                wrong_jacobian: false,
-            };
-            (h.name(), Box::new(h), h.exact(h.t_end()), h.t_end())
-        },
+/// One reference problem as a method runs it: its name, the system, and the exact state at
+/// the end time.
+struct Case {
+    name: &'static str,
+    problem: Box<dyn ReferenceDyn>,
+    exact: [f64; 2],
+    t_end: f64,
+}
+
+impl Case {
+    fn of<P: Reference + ReferenceDyn + 'static>(p: P) -> Self {
+        Case {
+            name: p.name(),
+            exact: p.exact(p.t_end()),
+            t_end: p.t_end(),
+            problem: Box::new(p),
+        }
+    }
+}
+
+/// The problems a method runs.
+fn problems(m: &Method) -> Vec<Case> {
+    let mut v = vec![
+        Case::of(Decay),
+        Case::of(Harmonic {
+            wrong_jacobian: false,
+        }),
     ];
     if m.implicit {
-        let h = Harmonic {
+        v.push(Case::of(Harmonic {
             wrong_jacobian: true,
-        };
-        v.push((h.name(), Box::new(h), h.exact(h.t_end()), h.t_end()));
-        v.push((
-            StiffLinear.name(),
-            Box::new(StiffLinear),
-            StiffLinear.exact(StiffLinear.t_end()),
-            StiffLinear.t_end(),
-        ));
+        }));
+        v.push(Case::of(StiffLinear));
     }
     v
 }
@@ -269,7 +274,13 @@ fn error(y: [f64; 2], exact: [f64; 2]) -> f64 {
 #[test]
 fn fixed_steps_converge_at_each_methods_order() {
     for m in methods() {
-        for (name, p, exact, t_end) in problems(&m) {
+        for Case {
+            name,
+            problem: p,
+            exact,
+            t_end,
+        } in problems(&m)
+        {
             let err_at = |n: usize| {
                 let ctl = StepControl {
                     rtol: 1.0,
@@ -295,7 +306,13 @@ fn fixed_steps_converge_at_each_methods_order() {
 #[test]
 fn global_error_falls_in_proportion_to_the_tolerance() {
     for m in methods() {
-        for (name, p, exact, _) in problems(&m) {
+        for Case {
+            name,
+            problem: p,
+            exact,
+            ..
+        } in problems(&m)
+        {
             let errs: Vec<f64> = m
                 .rtols
                 .iter()

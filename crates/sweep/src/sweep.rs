@@ -601,7 +601,7 @@ pub fn start_run(
     let id = RunIdentity {
         spec,
         spec_hash: spec_hash.clone(),
-        shard: tag.clone(),
+        shard: tag,
     };
     let what = match shard {
         Some(s) => format!("sweep --shard {} --shards {}", s.index, s.count),
