@@ -6,6 +6,7 @@
 //! - [`files`]: the name of every file and folder of a results folder, in one place.
 //! - [`record`], [`point`]: the record of one drop and the lines of `points.jsonl`, written
 //!   and read back through the same types, byte for byte.
+//! - [`summary`]: the rows of `summary.csv`, made from the lines of `points.jsonl`.
 //! - [`critical`]: the rows of `critical.json` and `critical.csv`.
 //! - [`orbit`]: the recorded orbits of `orbits/`.
 //! - [`contours`]: an ensemble's `contours.json`.
@@ -35,6 +36,7 @@ pub mod orbit;
 pub mod point;
 pub mod read;
 pub mod record;
+pub mod summary;
 
 pub use atomic::{write_atomic, write_atomic_with, WriteError};
 pub use read::{LoadError, ReadError};

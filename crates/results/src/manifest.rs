@@ -222,7 +222,7 @@ pub struct SortedKeys<T>(pub T);
 
 impl<T: Serialize> Serialize for SortedKeys<T> {
     fn serialize<Ser: serde::Serializer>(&self, s: Ser) -> Result<Ser::Ok, Ser::Error> {
-        // A `serde_json::Value` keeps its object keys sorted.
+        // A JSON value keeps its object keys sorted.
         serde_json::to_value(&self.0)
             .map_err(serde::ser::Error::custom)?
             .serialize(s)

@@ -57,6 +57,7 @@ use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::{simulate, DropOptions, Scene, MODEL_VERSION};
 use whirlmap_results::manifest::{Manifest, MergedShard, ShardTag, TimingRow};
 use whirlmap_results::point::PointLine;
+use whirlmap_results::summary::{SummaryRow, SummarySource};
 
 pub use whirlmap_results::files::{MANIFEST_FILE, POINTS_FILE, SUMMARY_FILE, TIMINGS_FILE};
 
@@ -364,45 +365,6 @@ pub fn read_points(path: &Path) -> std::io::Result<Vec<Value>> {
         .collect())
 }
 
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
-fn json_cell(v: Option<&Value>) -> String {
-    match v {
-        None | Some(Value::Null) => String::new(),
-        Some(Value::String(s)) => csv_field(s),
-        Some(other) => csv_field(&other.to_string()),
-    }
-}
-
-const SUMMARY_FIELDS: &[&str] = &[
-    "class",
-    "first_contact_force_n",
-    "max_contact_force_n",
-    "peak_friction_power_w",
-    "peak_heat_power_w",
-    "whirl_frequency_hz",
-    "contact_duty",
-    "impacts",
-    "end_time_s",
-];
-
-/// What the summary needs of a record line.
-#[derive(serde::Deserialize)]
-struct SummaryLine {
-    #[serde(default)]
-    status: Option<String>,
-    #[serde(default)]
-    record: Option<serde_json::Map<String, Value>>,
-    #[serde(default)]
-    error: Option<Value>,
-}
-
 /// Reads `points.jsonl` (one line per grid point in `indices`' order) and writes
 /// `summary.csv` from it, line by line. Returns (ok, failed, class counts).
 pub(crate) fn write_summary(
@@ -418,11 +380,8 @@ pub(crate) fn write_summary(
     let (mut ok, mut failed) = (0, 0);
     let mut read_error: Option<std::io::Error> = None;
     folder::write_atomic_with(&summary_path, |w| {
-        let mut header = vec!["index".to_string()];
-        header.extend(spec.axes.0.iter().map(|a| csv_field(&a.name)));
-        header.extend(SUMMARY_FIELDS.iter().map(|s| s.to_string()));
-        header.extend(["status".to_string(), "error".to_string()]);
-        writeln!(w, "{}", header.join(","))?;
+        let header = SummaryRow::header(spec.axes.0.iter().map(|a| a.name.as_str()));
+        writeln!(w, "{header}")?;
         for index in indices {
             let line = match lines.next() {
                 Some(Ok(l)) => l,
@@ -432,33 +391,25 @@ pub(crate) fn write_summary(
                 }
                 None => String::new(),
             };
-            let v: Option<SummaryLine> = serde_json::from_str(&line).ok();
-            let mut row = vec![index.to_string()];
-            row.extend(
-                spec.inputs_at(index)
-                    .iter()
-                    .map(|(_, x)| json_cell(Some(&Value::from(*x)))),
-            );
-            let rec = v.as_ref().and_then(|v| v.record.as_ref());
-            for f in SUMMARY_FIELDS {
-                row.push(json_cell(rec.and_then(|r| r.get(*f))));
-            }
-            let status = v.as_ref().and_then(|v| v.status.clone());
-            if status.as_deref() == Some("ok") {
+            let source = SummarySource::parse(&line);
+            if source.as_ref().is_some_and(SummarySource::is_ok) {
                 ok += 1;
-                if let Some(c) = rec.and_then(|r| r.get("class")).and_then(Value::as_str) {
-                    *classes.entry(c.to_string()).or_insert(0) += 1;
+                let class = source
+                    .as_ref()
+                    .and_then(|s| s.record.as_ref())
+                    .and_then(|r| r.class.clone());
+                if let Some(c) = class {
+                    *classes.entry(c).or_insert(0) += 1;
                 }
             } else {
                 failed += 1;
             }
-            row.push(json_cell(status.map(Value::from).as_ref()));
-            row.push(json_cell(
-                v.as_ref()
-                    .and_then(|v| v.error.as_ref())
-                    .and_then(|e| e.get("message")),
-            ));
-            writeln!(w, "{}", row.join(","))?;
+            let row = SummaryRow {
+                index,
+                inputs: spec.inputs_at(index).iter().map(|(_, x)| *x).collect(),
+                source,
+            };
+            writeln!(w, "{}", row.to_csv_line())?;
         }
         Ok(())
     })?;
@@ -917,6 +868,26 @@ pub fn run_grid(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_summary_of_committed_records_is_the_committed_summary() {
+        for name in ["paper", "paper-radial"] {
+            let src = Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../results")
+                .join(name);
+            let spec = folder::manifest_spec(&src).expect("a committed manifest");
+            let dir = std::env::temp_dir()
+                .join(format!("whirlmap-summary-{name}-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::copy(src.join(POINTS_FILE), dir.join(POINTS_FILE)).unwrap();
+            let n = spec.grid().unwrap().len();
+            write_summary(&spec, &dir, &mut (0..n)).unwrap();
+            let made = std::fs::read(dir.join(SUMMARY_FILE)).unwrap();
+            let committed = std::fs::read(src.join(SUMMARY_FILE)).unwrap();
+            assert!(made == committed, "{name}: summary.csv differs");
+            std::fs::remove_dir_all(&dir).ok();
+        }
+    }
 
     fn point(scene: Scene) -> Point {
         Point {
