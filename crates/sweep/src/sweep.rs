@@ -44,7 +44,6 @@ use crate::run::{catch_drop, DropFailure};
 use crate::spec::{Grid, Point, SpecError, SweepSpec};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
-use serde_json::Value;
 use std::collections::{BTreeMap, HashMap};
 use std::fs::{File, OpenOptions};
 use std::io::{BufRead, IsTerminal, Read, Write};
@@ -353,16 +352,6 @@ fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
         );
     }
     Ok(map)
-}
-
-/// Reads the records of a `points.jsonl` as JSON values, skipping a torn or corrupt line
-/// (for charts and tools).
-pub fn read_points(path: &Path) -> std::io::Result<Vec<Value>> {
-    let text = std::fs::read_to_string(path)?;
-    Ok(text
-        .lines()
-        .filter_map(|l| serde_json::from_str(l).ok())
-        .collect())
 }
 
 /// Reads `points.jsonl` (one line per grid point in `indices`' order) and writes
