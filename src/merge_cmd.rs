@@ -8,7 +8,7 @@
 //! without --overwrite) with every problem listed; 4 an output could not be written.
 
 use std::path::PathBuf;
-use whirlmap_sweep::merge::{merge, ChartsFailed};
+use whirlmap_sweep::merge::merge;
 
 /// Arguments of `whirlmap merge`.
 #[derive(clap::Args)]
@@ -38,13 +38,7 @@ pub fn run(a: &MergeArgs) -> u8 {
             }
         },
     };
-    let draw = |dir: &std::path::Path| {
-        whirlmap_plot::render_all(dir).map_err(|e| ChartsFailed {
-            message: e.to_string(),
-            output: e.is_output(),
-        })
-    };
-    match merge(&a.dirs, &out, a.overwrite, &draw) {
+    match merge(&a.dirs, &out, a.overwrite, &crate::sweep_cmd::draw_charts) {
         Ok(o) => {
             for w in &o.warnings {
                 errln!("warning: {w}");

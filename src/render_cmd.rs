@@ -1,20 +1,24 @@
-//! `whirlmap render DIR`: draw the design charts of a sweep's results directory.
+//! `whirlmap render DIR`: redraw the charts of a results directory: a sweep's (or a merge's)
+//! design charts, an ensemble's Fig. 4 with probability bands. An adaptive map
+//! (`adaptive.json`) has no charts: render says so and exits 0.
 //!
 //! The folder is locked while the charts are drawn (a sweep writing it is not raced), its
 //! inputs are checked against its manifest first (a `critical.json` or orbit the run did not
 //! write is refused rather than drawn: `whirlmap_sweep::folder`), charts the data no longer
 //! has are removed, and the manifest's file list is brought up to date.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use whirlmap_plot::{render_all, ChartError};
 use whirlmap_sweep::folder::{self, FolderLock};
+use whirlmap_sweep::results::files::{ADAPTIVE_FILE, CONTOURS_FILE, POINTS_FILE};
 
 /// Arguments of `whirlmap render`.
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Results directory of a sweep (holding points.jsonl, optionally critical.json and
-    /// orbits/); the charts are written to DIR/charts/ as PNG and SVG.
+    /// Results directory of a sweep or merge (holding points.jsonl, optionally critical.json
+    /// and orbits/) or of an ensemble (contours.json); the charts are written to DIR/charts/
+    /// as PNG and SVG.
     pub dir: PathBuf,
 }
 
@@ -27,13 +31,30 @@ pub enum RenderFailure {
     Output(anyhow::Error),
 }
 
-/// Draws every chart whose data exists and prints the files written.
+/// Whether `dir` holds only an adaptive map: `adaptive.json` and no sweep records or ensemble
+/// contours (the files charts are drawn from).
+fn is_adaptive_map(dir: &Path) -> bool {
+    dir.join(ADAPTIVE_FILE).is_file()
+        && !dir.join(POINTS_FILE).is_file()
+        && !dir.join(CONTOURS_FILE).is_file()
+}
+
+/// Draws every chart whose data exists and prints the files written; says so and draws
+/// nothing for an adaptive map, which has no charts.
 pub fn run(a: &RenderArgs) -> Result<(), RenderFailure> {
     if !a.dir.is_dir() {
         return Err(RenderFailure::Input(anyhow::anyhow!(
             "no sweep results: {} is not a folder",
             a.dir.display()
         )));
+    }
+    if is_adaptive_map(&a.dir) {
+        outln!(
+            "{}: an adaptive map ({ADAPTIVE_FILE}); `whirlmap adaptive` draws no charts, so there \
+             are none to draw",
+            a.dir.display()
+        );
+        return Ok(());
     }
     let _lock = FolderLock::acquire(&a.dir, "render").map_err(|e| match e.exit_code() {
         4 => RenderFailure::Output(e.into()),

@@ -4,7 +4,8 @@
 
 use crate::sweep_cmd::SweepArgs;
 use std::path::PathBuf;
-use whirlmap_sweep::shard::{run_shard, Shard};
+use whirlmap_sweep::pipeline::{self, Stages};
+use whirlmap_sweep::shard::Shard;
 use whirlmap_sweep::spec::SweepSpec;
 use whirlmap_sweep::sweep::{ProgressMode, RunOptions};
 
@@ -33,8 +34,12 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> u8 {
             ProgressMode::Auto
         },
     };
-    let (outcome, critical) = match run_shard(spec, &opts, shard) {
-        Ok(o) => o,
+    let stages = Stages {
+        on_grid: &|_| {},
+        draw_charts: &crate::sweep_cmd::draw_charts,
+    };
+    let (outcome, critical) = match pipeline::run(spec, &opts, Some(shard), &stages) {
+        Ok(o) => (o.outcome, o.extras.critical),
         Err(e) => {
             errln!("error: {e}");
             return e.exit_code();

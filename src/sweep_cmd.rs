@@ -4,9 +4,18 @@
 //! unusable output folder, or one that is in use or holds another run's results (nothing
 //! run); 4 an output (records or charts) could not be written, a full disk included.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use whirlmap_sweep::pipeline::{self, ChartsFailed, Stages};
 use whirlmap_sweep::spec;
-use whirlmap_sweep::sweep::{run_sweep, ProgressMode, RunOptions};
+use whirlmap_sweep::sweep::{ProgressMode, RunOptions, SweepOutcome};
+
+/// Draws every chart of the results folder `dir` (the pipeline's chart stage).
+pub(crate) fn draw_charts(dir: &Path) -> Result<Vec<PathBuf>, ChartsFailed> {
+    whirlmap_plot::render_all(dir).map_err(|e| ChartsFailed {
+        message: e.to_string(),
+        output: e.is_output(),
+    })
+}
 
 /// Arguments of `whirlmap sweep`.
 #[derive(clap::Args)]
@@ -68,77 +77,49 @@ pub fn run(a: &SweepArgs) -> u8 {
             ProgressMode::Auto
         },
     };
-    let mut run = match run_sweep(&spec, &opts) {
-        Ok(o) => o,
+    let on_grid = |outcome: &SweepOutcome| {
+        outln!(
+            "sweep {}: {} points, {} ok, {} failed{}",
+            spec.name,
+            outcome.points,
+            outcome.ok,
+            outcome.failed,
+            if outcome.skipped > 0 {
+                format!(" ({} resumed)", outcome.skipped)
+            } else {
+                String::new()
+            }
+        );
+        for (class, n) in &outcome.classes {
+            outln!("  {class:<16} {n}");
+        }
+        outln!("  output           {}", outcome.out_dir.display());
+    };
+    let stages = Stages {
+        on_grid: &on_grid,
+        draw_charts: &draw_charts,
+    };
+    let done = match pipeline::run(&spec, &opts, None, &stages) {
+        Ok(d) => d,
         Err(e) => {
             errln!("error: {e}");
             return e.exit_code();
         }
     };
-    let outcome = run.outcome.clone();
-    outln!(
-        "sweep {}: {} points, {} ok, {} failed{}",
-        spec.name,
-        outcome.points,
-        outcome.ok,
-        outcome.failed,
-        if outcome.skipped > 0 {
-            format!(" ({} resumed)", outcome.skipped)
-        } else {
-            String::new()
-        }
-    );
-    for (class, n) in &outcome.classes {
-        outln!("  {class:<16} {n}");
+    let x = &done.extras;
+    if let Some(p) = &x.critical {
+        outln!("  critical speeds  {}", p.display());
     }
-    outln!("  output           {}", outcome.out_dir.display());
-    let progress = !a.no_progress;
-    let dir = outcome.out_dir.clone();
-    match whirlmap_sweep::extras::run_all(&spec, &dir, opts.threads, progress) {
-        Ok(x) => {
-            let mut listed = Vec::new();
-            if let Some(p) = &x.critical {
-                outln!("  critical speeds  {}", p.display());
-                listed.push(p.clone());
-                listed.push(dir.join(whirlmap_sweep::results::files::CRITICAL_CSV_FILE));
-            }
-            if !x.orbits.is_empty() {
-                outln!("  orbits           {} drops recorded", x.orbits.len());
-            }
-            listed.push(dir.join(whirlmap_sweep::results::files::ORBITS_DIR));
-            if let Some(p) = &x.probability {
-                outln!("  probability      {}", p.display());
-                listed.push(p.clone());
-            }
-            for p in &listed {
-                if let Err(e) = run.record(p) {
-                    errln!("error: {e}");
-                    return e.exit_code();
-                }
-            }
-        }
-        Err(e) => {
-            errln!("error: {e}");
-            return 4;
-        }
+    if !x.orbits.is_empty() {
+        outln!("  orbits           {} drops recorded", x.orbits.len());
     }
-    if !spec.charts.is_empty() {
-        match whirlmap_plot::render_all(&dir) {
-            Ok(written) => outln!("  charts           {} files", written.len()),
-            Err(e) => {
-                errln!("error: charts: {e}");
-                return 4;
-            }
-        }
-        if let Err(e) = run.record(&dir.join(whirlmap_sweep::results::files::CHARTS_DIR)) {
-            errln!("error: {e}");
-            return e.exit_code();
-        }
+    if let Some(p) = &x.probability {
+        outln!("  probability      {}", p.display());
     }
-    if let Err(e) = run.finish() {
-        errln!("error: {e}");
-        return e.exit_code();
+    if let Some(written) = &done.charts {
+        outln!("  charts           {} files", written.len());
     }
+    let outcome = done.outcome;
     if outcome.failed > 0 {
         1
     } else {

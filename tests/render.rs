@@ -142,3 +142,70 @@ fn a_sweep_draws_only_the_charts_its_spec_lists() {
         4
     );
 }
+
+#[test]
+fn render_redraws_an_ensemble_and_says_an_adaptive_map_has_no_charts() {
+    let results = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("results");
+    // An adaptive map: no charts to draw, said plainly, exit 0, the folder left as it was.
+    let adaptive = temp_dir("adaptive");
+    std::fs::copy(
+        results.join("adaptive-paper/adaptive.json"),
+        adaptive.join("adaptive.json"),
+    )
+    .unwrap();
+    let out = whirlmap(&["render".as_ref(), adaptive.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("no charts") && said.contains("adaptive"),
+        "{said}"
+    );
+    assert!(!adaptive.join("charts").exists());
+
+    // An ensemble: Fig. 4 with probability bands, as `whirlmap ensemble` drew it.
+    let ensemble = temp_dir("ensemble");
+    std::fs::copy(
+        results.join("ensemble-paper/contours.json"),
+        ensemble.join("contours.json"),
+    )
+    .unwrap();
+    let out = whirlmap(&["render".as_ref(), ensemble.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    for ext in ["png", "svg"] {
+        let drawn = std::fs::read(ensemble.join(format!("charts/fig4_probability.{ext}"))).unwrap();
+        let committed =
+            std::fs::read(results.join(format!("ensemble-paper/charts/fig4_probability.{ext}")))
+                .unwrap();
+        assert!(
+            drawn == committed,
+            "fig4_probability.{ext} differs from the committed one"
+        );
+    }
+}
+
+/// Copies the folder `from` into `to`, recursively.
+fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            copy_tree(&p, &to.join(e.file_name()));
+        } else {
+            std::fs::copy(&p, to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+#[test]
+fn render_leaves_a_committed_manifest_as_it_was() {
+    // The charts come out the same, so the manifest (read and written as its typed form)
+    // must come out byte for byte the same too, its keys in the order the run wrote them.
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("results/paper-radial");
+    let dir = temp_dir("relist");
+    copy_tree(&src, &dir);
+    let out = whirlmap(&["render".as_ref(), dir.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let before = std::fs::read_to_string(src.join("manifest.json")).unwrap();
+    let after = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
+    assert!(before == after, "render rewrote manifest.json");
+}

@@ -41,8 +41,8 @@ fn dop853_confirms_dopri5_on_the_first_impacts() {
     // Eighth order takes far fewer steps for the same tolerance. Measured: 1.93x fewer with
     // the isotropic support damper (2579 against 1339 steps; more than 2x with the
     // radial-only damper, whose undamped race ringing costs the lower order more). The
-    // bound, 1.5x, is a property of the order, not of this drop; each stepper's own order
-    // test checks the order itself.
+    // bound, 1.5x, is a property of the order, not of this drop; the steppers' harness
+    // (`tests/steppers.rs`) checks the order itself.
     assert!(
         b.stats.steps * 3 < a.stats.steps * 2,
         "{:?} {:?}",

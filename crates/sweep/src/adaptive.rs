@@ -39,6 +39,9 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+pub use whirlmap_results::adaptive::{
+    AdaptiveReport, Agreement, BoundaryPoint, Comparison, Corner,
+};
 
 pub use whirlmap_results::files::ADAPTIVE_FILE;
 
@@ -355,18 +358,6 @@ pub fn boundary(map: &[f64], shape: (usize, usize), level: f64) -> Vec<Option<f6
         .collect()
 }
 
-/// How two boundaries (from [`boundary`]) agree.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Agreement {
-    /// Largest distance between the two crossings over the columns where both have one, in
-    /// fine speed steps.
-    pub max_shift_cells: f64,
-    /// Columns where one has a crossing and the other not.
-    pub columns_differing: usize,
-    /// Fine points whose bin (safe, uncertain, whirl) differs between the two maps.
-    pub points_differing: usize,
-}
-
 /// Compares an inferred map with the full one at `level` (and `bounds` for the bins).
 pub fn agreement(
     inferred: &[f64],
@@ -396,72 +387,6 @@ pub fn agreement(
         columns_differing,
         points_differing,
     }
-}
-
-/// One evaluated corner in `adaptive.json`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Corner {
-    /// Release speed (r/min).
-    pub speed_rpm: f64,
-    /// Friction coefficient.
-    pub mu: f64,
-    /// P(whirl) (single drops: 1 whirl, 0 not; null failed).
-    pub p_whirl: f64,
-}
-
-/// The boundary at one mu.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct BoundaryPoint {
-    /// Friction coefficient.
-    pub mu: f64,
-    /// Where P(whirl) first reaches 1/2 along speed in the adaptive map (r/min).
-    pub speed_rpm: Option<f64>,
-    /// The same in the full grid (with `--compare-full`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub full_speed_rpm: Option<Option<f64>>,
-}
-
-/// The full-grid comparison of `adaptive.json`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Comparison {
-    /// Drops of the full fine grid.
-    pub full_grid_drops: usize,
-    /// How the boundaries agree.
-    pub agreement: Agreement,
-}
-
-/// The contents of `adaptive.json`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AdaptiveReport {
-    /// Spec name.
-    pub name: String,
-    /// Fine grid points along speed and mu.
-    pub fine_points: (usize, usize),
-    /// Seed grid points along speed and mu.
-    pub seed_points: (usize, usize),
-    /// The bins' bounds.
-    pub p_bounds: [f64; 2],
-    /// Drops per corner (1, or the ensemble's members).
-    pub drops_per_corner: usize,
-    /// Refinement rounds after the seed grid.
-    pub rounds: usize,
-    /// Corners evaluated.
-    pub corners: usize,
-    /// Drops the adaptive search used.
-    pub drops_used: usize,
-    /// Drops of the full fine grid it replaces.
-    pub full_grid_drops: usize,
-    /// `drops_used / full_grid_drops`.
-    pub drops_ratio: f64,
-    /// Boundary cells (refined to the smallest size).
-    pub boundary_cells: usize,
-    /// Per mu, the 50 % crossing along speed.
-    pub boundary: Vec<BoundaryPoint>,
-    /// With `--compare-full`: the full grid's drops and the agreement.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub comparison: Option<Comparison>,
-    /// Every evaluated corner, in index order.
-    pub evaluated: Vec<Corner>,
 }
 
 /// Evaluates fine points: one drop each (whirl 1, not 0, failed NaN), or an ensemble each
@@ -607,8 +532,7 @@ pub fn run_adaptive(
             .collect(),
     };
     let path = out_dir.join(ADAPTIVE_FILE);
-    let text = serde_json::to_string_pretty(&report).expect("report serialises");
-    crate::folder::write_atomic(&path, format!("{text}\n").as_bytes())?;
+    crate::folder::write_atomic(&path, report.to_text().as_bytes())?;
     Ok((report, path))
 }
 

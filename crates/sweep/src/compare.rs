@@ -21,12 +21,10 @@
 //! of the new run whose changed cells are outlined (drawn by the function its caller hands
 //! in: this crate draws nothing).
 
-use serde_json::Value;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use whirlmap_results::critical::{read_critical, CriticalRow};
-use whirlmap_results::files::MANIFEST_FILE;
 use whirlmap_results::grid::{assemble_grid, Grid};
 use whirlmap_results::point::{load_points, PointRow, PointStatus};
 use whirlmap_results::read::LoadError;
@@ -155,20 +153,16 @@ pub enum CompareError {
 }
 
 fn run_info(dir: &Path) -> RunInfo {
-    let m: Value = std::fs::read_to_string(dir.join(MANIFEST_FILE))
+    let m = crate::folder::read_manifest(dir)
         .ok()
-        .and_then(|t| serde_json::from_str(&t).ok())
-        .unwrap_or(Value::Null);
-    let text = |v: Option<&Value>| match v {
-        Some(Value::String(s)) => s.clone(),
-        Some(Value::Null) | None => "?".to_string(),
-        Some(v) => v.to_string(),
-    };
+        .flatten()
+        .unwrap_or_default();
+    let text = |v: Option<&str>| v.unwrap_or("?").to_string();
     RunInfo {
-        name: text(m.get("spec").and_then(|s| s.get("name"))),
-        model_version: text(m.get("model_version")),
-        git_commit: text(m.get("git_commit")),
-        spec_hash: text(m.get("spec_hash")),
+        name: text(m.spec_name()),
+        model_version: m.model_version.map_or("?".to_string(), |v| v.to_string()),
+        git_commit: text(m.git_commit.as_deref()),
+        spec_hash: text(m.spec_hash.as_deref()),
     }
 }
 

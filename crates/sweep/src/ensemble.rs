@@ -67,6 +67,8 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::Scene;
+pub use whirlmap_results::ensemble::{percentile, CellStats, Drawn, MemberRecord, Percentiles};
+use whirlmap_results::manifest::{EnsembleManifest, SortedKeys};
 
 /// Per-cell statistics as CSV.
 pub const CELLS_CSV: &str = "cells.csv";
@@ -263,21 +265,6 @@ pub struct EnsembleSpec {
     /// settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fidelity: Option<whirlmap_core::Fidelity>,
-}
-
-/// What one member drew (its release), as recorded in `members.jsonl`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Drawn {
-    /// Unbalance eccentricity (m).
-    pub unbalance_m: f64,
-    /// Unbalance angle at release (rad).
-    pub unbalance_phase_rad: f64,
-    /// Rotor centre at release (m).
-    pub release_offset_m: [f64; 2],
-    /// Rotor centre velocity at release (m/s).
-    pub release_velocity_m_s: [f64; 2],
-    /// Race spin at release (rad/s).
-    pub race_speed_rad_s: f64,
 }
 
 fn invalid(field: &str, value: impl ToString, allowed: &str) -> SpecError {
@@ -554,99 +541,6 @@ pub fn wilson(k: usize, n: usize, z: f64) -> (f64, f64) {
     let centre = (p + z2 / (2.0 * n)) / denom;
     let half = z / denom * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt();
     ((centre - half).max(0.0), (centre + half).min(1.0))
-}
-
-/// The `q` quantile (0..=1) of `sorted` (ascending), linear between order statistics
-/// (Hyndman-Fan type 7, numpy's default). NaN when empty.
-pub fn percentile(sorted: &[f64], q: f64) -> f64 {
-    match sorted.len() {
-        0 => f64::NAN,
-        1 => sorted[0],
-        n => {
-            let h = q.clamp(0.0, 1.0) * (n - 1) as f64;
-            let i = (h.floor() as usize).min(n - 2);
-            sorted[i] + (h - i as f64) * (sorted[i + 1] - sorted[i])
-        }
-    }
-}
-
-/// p10, p50 and p90 of a quantity over a cell's ok members (NaN, written null, if none).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Percentiles {
-    /// 10th percentile.
-    pub p10: f64,
-    /// Median.
-    pub p50: f64,
-    /// 90th percentile.
-    pub p90: f64,
-}
-
-impl Percentiles {
-    /// From unsorted values (non-finite ones dropped).
-    pub fn of(values: &[f64]) -> Self {
-        let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-        v.sort_by(f64::total_cmp);
-        Self {
-            p10: percentile(&v, 0.1),
-            p50: percentile(&v, 0.5),
-            p90: percentile(&v, 0.9),
-        }
-    }
-}
-
-/// One member's outcome, as written to `members.jsonl`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct MemberRecord {
-    /// Cell index.
-    pub cell: usize,
-    /// Member index in the cell.
-    pub member: usize,
-    /// The cell's inputs.
-    pub inputs: Inputs,
-    /// What the member drew.
-    pub drawn: Drawn,
-    /// Stable hash of the member's scene.
-    pub scene_hash: String,
-    /// Orbit class; `None` when the drop failed.
-    pub class: Option<OrbitClass>,
-    /// Maximum contact force (N).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub max_contact_force_n: Option<f64>,
-    /// Peak heat power (W).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub peak_heat_power_w: Option<f64>,
-    /// The failure, `kind: message`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub error: Option<String>,
-}
-
-/// Statistics of one cell, as written to `cells.jsonl`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct CellStats {
-    /// Cell index.
-    pub index: usize,
-    /// Axis name -> value.
-    pub inputs: BTreeMap<String, f64>,
-    /// Members run.
-    pub members: usize,
-    /// Members that finished.
-    pub ok: usize,
-    /// Members that failed (left out of everything below).
-    pub failed: usize,
-    /// Members that whirled (backward or forward).
-    pub whirl: usize,
-    /// whirl / ok (NaN, written null, when no member finished).
-    pub p_whirl: f64,
-    /// Wilson interval lower end.
-    pub p_lo: f64,
-    /// Wilson interval upper end.
-    pub p_hi: f64,
-    /// Class name -> members.
-    pub classes: BTreeMap<String, usize>,
-    /// Maximum contact force (N) over the ok members.
-    pub max_contact_force_n: Percentiles,
-    /// Peak heat power (W) over the ok members.
-    pub peak_heat_power_w: Percentiles,
 }
 
 /// Summarises one cell's members (in member order) at normal quantile `z`.
@@ -975,20 +869,19 @@ pub fn run_ensemble_here(
         &mut written,
     )?;
     let failed = members.iter().filter(|m| m.class.is_none()).count();
-    let manifest = serde_json::json!({
-        "spec": spec,
-        "whirlmap_version": env!("CARGO_PKG_VERSION"),
-        "model_version": whirlmap_core::MODEL_VERSION,
-        "threads": rayon::current_num_threads(),
-        "cells": cells.len(),
-        "drops": members.len(),
-        "failed": failed,
-        "wall_time_s": start.elapsed().as_secs_f64(),
-    });
-    let text = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
+    let manifest = EnsembleManifest {
+        cells: cells.len(),
+        drops: members.len(),
+        failed,
+        model_version: whirlmap_core::MODEL_VERSION,
+        spec: SortedKeys(spec),
+        threads: rayon::current_num_threads(),
+        wall_time_s: start.elapsed().as_secs_f64(),
+        whirlmap_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
     write_file(
         &out_dir.join(MANIFEST_FILE),
-        &format!("{text}\n"),
+        &manifest.to_text(),
         &mut written,
     )?;
     Ok(EnsembleOutcome {

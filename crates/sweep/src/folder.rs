@@ -29,18 +29,18 @@
 
 use crate::spec::SweepSpec;
 use crate::sweep::{io_err, SweepError};
-use serde::{Deserialize, Serialize};
+use serde::Deserialize;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
-use whirlmap_core::scene::fnv1a64;
 use whirlmap_results::files::{
     CHARTS_DIR, COMPARE_CLASSES_FILE, COMPARE_REPORT_FILE, CONTOURS_FILE, CRITICAL_CSV_FILE,
     CRITICAL_FILE, MANIFEST_FILE, ORBITS_DIR, POINTS_FILE, PROBABILITY_DIR, SHARD_FILE,
     SUMMARY_FILE, TIMINGS_FILE,
 };
+use whirlmap_results::manifest::{Manifest, ShardTag};
 
 pub use whirlmap_results::files::{LOCK_FILE, PREVIOUS_DIR};
 
@@ -212,40 +212,7 @@ fn remove_leftovers(dir: &Path) {
     }
 }
 
-/// One file in the manifest's list.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct FileEntry {
-    /// Its size in bytes.
-    pub bytes: u64,
-    /// FNV-1a 64 of its bytes, 16 hex digits.
-    pub fnv1a64: String,
-}
-
-impl FileEntry {
-    /// Reads `path` in blocks and hashes it.
-    pub fn of(path: &Path) -> std::io::Result<Self> {
-        let mut f = File::open(path)?;
-        let mut buf = vec![0u8; 1 << 16];
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        let mut bytes = 0u64;
-        loop {
-            let n = f.read(&mut buf)?;
-            if n == 0 {
-                break;
-            }
-            bytes += n as u64;
-            for b in &buf[..n] {
-                h ^= *b as u64;
-                h = h.wrapping_mul(0x0000_0100_0000_01b3);
-            }
-        }
-        debug_assert_eq!(fnv1a64(b""), 0xcbf2_9ce4_8422_2325);
-        Ok(Self {
-            bytes,
-            fnv1a64: format!("{h:016x}"),
-        })
-    }
-}
+pub use whirlmap_results::manifest::{read_manifest, FileEntry, ManifestView};
 
 /// How a run treats a folder that already holds results.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -288,8 +255,8 @@ pub struct RunIdentity<'a> {
     pub spec: &'a SweepSpec,
     /// Its hash.
     pub spec_hash: String,
-    /// The shard section of the manifest (`{"index", "count"}`), `None` for a whole run.
-    pub shard: Option<Value>,
+    /// The shard section of the manifest, `None` for a whole run.
+    pub shard: Option<ShardTag>,
 }
 
 impl RunFolder {
@@ -457,12 +424,9 @@ fn remove_path(p: &Path) -> Result<(), SweepError> {
 fn describe_manifest(dir: &Path) -> String {
     match read_manifest(dir) {
         Ok(Some(m)) => {
-            let name = m
-                .pointer("/spec/name")
-                .and_then(Value::as_str)
-                .unwrap_or("?");
-            let hash = m.get("spec_hash").and_then(Value::as_str);
-            let state = match m.get("complete").and_then(Value::as_bool) {
+            let name = m.spec_name().unwrap_or("?");
+            let hash = m.spec_hash.as_deref();
+            let state = match m.complete {
                 Some(true) => "finished",
                 Some(false) => "did not finish",
                 None => "written by an older whirlmap",
@@ -474,18 +438,6 @@ fn describe_manifest(dir: &Path) -> String {
         }
         Ok(None) => "no manifest.json".to_string(),
         Err(e) => e,
-    }
-}
-
-/// The folder's `manifest.json` as JSON, `None` when there is none.
-pub fn read_manifest(dir: &Path) -> Result<Option<Value>, String> {
-    let path = dir.join(MANIFEST_FILE);
-    match std::fs::read_to_string(&path) {
-        Ok(t) => serde_json::from_str(&t)
-            .map(Some)
-            .map_err(|e| format!("{}: {e}", path.display())),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(format!("{}: {e}", path.display())),
     }
 }
 
@@ -507,37 +459,33 @@ fn check_resumable(dir: &Path, id: &RunIdentity) -> Result<(), SweepError> {
         }
         Err(e) => return Err(refuse(format!("its manifest is unreadable ({e})"))),
     };
-    if m.get("complete").is_none() {
+    if m.complete.is_none() {
         return Err(refuse(
             "it was written by an older whirlmap, whose manifest names neither its build nor \
              its files"
                 .into(),
         ));
     }
-    let old_shard = m.get("shard").cloned().filter(|v| !v.is_null());
+    let old_shard = m.shard;
     if old_shard != id.shard {
-        let part = |v: &Option<Value>| match v {
-            Some(s) => format!(
-                "shard {}/{}",
-                s.get("index").unwrap_or(&Value::Null),
-                s.get("count").unwrap_or(&Value::Null)
-            ),
+        let part = |v: &Option<ShardTag>| match v {
+            Some(s) => format!("shard {}/{}", s.index, s.count),
             None => "a whole sweep".to_string(),
         };
         return Err(refuse(format!(
             "it holds {} of spec {}, not {} of spec {}",
             part(&old_shard),
-            m.get("spec_hash").and_then(Value::as_str).unwrap_or("?"),
+            m.spec_hash.as_deref().unwrap_or("?"),
             part(&id.shard),
             id.spec_hash
         )));
     }
-    let old_hash = m.get("spec_hash").and_then(Value::as_str).unwrap_or("?");
+    let old_hash = m.spec_hash.as_deref().unwrap_or("?");
     if old_hash != id.spec_hash {
         let diffs = match manifest_spec(dir) {
             Some(old) => spec_differences(&old, id.spec),
             None => value_differences(
-                m.get("spec").unwrap_or(&Value::Null),
+                m.spec.as_ref().unwrap_or(&Value::Null),
                 &serde_json::to_value(id.spec).expect("specs serialise"),
             ),
         };
@@ -551,11 +499,7 @@ fn check_resumable(dir: &Path, id: &RunIdentity) -> Result<(), SweepError> {
             }
         )));
     }
-    let field = |k: &str| {
-        m.get(k)
-            .map(|v| v.as_str().map(str::to_string).unwrap_or(v.to_string()))
-    };
-    let old_build = (field("whirlmap_version"), field("git_commit"));
+    let old_build = (m.whirlmap_version.clone(), m.git_commit.clone());
     let this = (
         Some(crate::build_info::VERSION.to_string()),
         Some(crate::build_info::GIT_COMMIT.to_string()),
@@ -571,7 +515,7 @@ fn check_resumable(dir: &Path, id: &RunIdentity) -> Result<(), SweepError> {
             crate::build_info::DESCRIPTION
         )));
     }
-    let model = m.get("model_version").and_then(Value::as_u64);
+    let model = m.model_version;
     if model != Some(whirlmap_core::MODEL_VERSION as u64) {
         return Err(refuse(format!(
             "it was run with model version {}, this whirlmap has {}",
@@ -673,7 +617,7 @@ pub struct Checked {
     /// not finish.
     pub warnings: Vec<String>,
     /// The manifest, when there is one.
-    pub manifest: Option<Value>,
+    pub manifest: Option<ManifestView>,
     /// Whether the manifest has a file list (written by this version of whirlmap).
     pub listed: bool,
 }
@@ -681,21 +625,15 @@ pub struct Checked {
 impl Checked {
     /// The spec recorded in the manifest, if any.
     pub fn spec(&self) -> Option<&Value> {
-        self.manifest.as_ref().and_then(|m| m.get("spec"))
+        self.manifest.as_ref().and_then(|m| m.spec.as_ref())
     }
     /// The spec hash recorded in the manifest, if any.
     pub fn spec_hash(&self) -> Option<&str> {
-        self.manifest
-            .as_ref()
-            .and_then(|m| m.get("spec_hash"))
-            .and_then(Value::as_str)
+        self.manifest.as_ref().and_then(|m| m.spec_hash.as_deref())
     }
     /// Whether the manifest says the run finished (`None`: no manifest or an older one).
     pub fn complete(&self) -> Option<bool> {
-        self.manifest
-            .as_ref()
-            .and_then(|m| m.get("complete"))
-            .and_then(Value::as_bool)
+        self.manifest.as_ref().and_then(|m| m.complete)
     }
 }
 
@@ -743,7 +681,7 @@ pub fn check_inputs(dir: &Path, inputs: &[String]) -> Result<Checked, Vec<String
         ));
         return Ok(checked);
     };
-    let Some(files) = m.get("files").and_then(Value::as_object) else {
+    let Some(files) = &m.files else {
         checked.warnings.push(format!(
             "{} was written by an older whirlmap (its manifest has no file list): its files \
              cannot be checked against the run that wrote them",
@@ -752,7 +690,7 @@ pub fn check_inputs(dir: &Path, inputs: &[String]) -> Result<Checked, Vec<String
         return Ok(checked);
     };
     checked.listed = true;
-    let complete = m.get("complete").and_then(Value::as_bool) == Some(true);
+    let complete = m.complete == Some(true);
     if !complete {
         checked.warnings.push(format!(
             "{} holds a run that did not finish (manifest.json: complete = false): its \
@@ -760,27 +698,21 @@ pub fn check_inputs(dir: &Path, inputs: &[String]) -> Result<Checked, Vec<String
             dir.display()
         ));
     }
-    let name = m
-        .pointer("/spec/name")
-        .and_then(Value::as_str)
-        .unwrap_or("?");
-    let hash = m.get("spec_hash").and_then(Value::as_str).unwrap_or("?");
+    let name = m.spec_name().unwrap_or("?");
+    let hash = m.spec_hash.as_deref().unwrap_or("?");
     let mut problems = Vec::new();
     for rel in inputs {
         let path = dir.join(rel);
         match files.get(rel) {
-            Some(listed) => {
-                let listed: Option<FileEntry> = serde_json::from_value(listed.clone()).ok();
-                match FileEntry::of(&path) {
-                    Ok(actual) if Some(&actual) == listed.as_ref() => {}
-                    Ok(_) => problems.push(format!(
-                        "{} is not the file the run of spec \"{name}\" (hash {hash}) wrote: \
+            Some(listed) => match FileEntry::of(&path) {
+                Ok(actual) if &actual == listed => {}
+                Ok(_) => problems.push(format!(
+                    "{} is not the file the run of spec \"{name}\" (hash {hash}) wrote: \
                          its size or content changed afterwards",
-                        path.display()
-                    )),
-                    Err(e) => problems.push(format!("{}: {e}", path.display())),
-                }
-            }
+                    path.display()
+                )),
+                Err(e) => problems.push(format!("{}: {e}", path.display())),
+            },
             // The records of a run in progress or killed: not listed until the grid ends.
             None if !complete && (rel == POINTS_FILE || rel == TIMINGS_FILE) => {}
             // A run that did not finish lists a file only once its stage is done; the folder
@@ -808,13 +740,17 @@ pub fn check_inputs(dir: &Path, inputs: &[String]) -> Result<Checked, Vec<String
 /// Rewrites the manifest of `dir` with the subfolder `rel` listed anew (after `render`
 /// redrew `charts/`); does nothing for a folder whose manifest has no file list.
 pub fn relist_tree(dir: &Path, rel: &str) -> Result<(), SweepError> {
-    let Ok(Some(mut m)) = read_manifest(dir) else {
+    // Read as written, so that everything but the list is written back unchanged; a manifest
+    // this build cannot read as its own (an older whirlmap's) is left alone.
+    let path = dir.join(MANIFEST_FILE);
+    let Ok(text) = std::fs::read_to_string(&path) else {
         return Ok(());
     };
-    let Some(files) = m.get_mut("files").and_then(Value::as_object_mut) else {
+    let Ok(mut m) = serde_json::from_str::<Manifest<SweepSpec>>(&text) else {
         return Ok(());
     };
-    files.retain(|k, _| !(k.starts_with(rel) && k[rel.len()..].starts_with('/')));
+    m.files
+        .retain(|k, _| !(k.starts_with(rel) && k[rel.len()..].starts_with('/')));
     let root = dir.join(rel);
     let mut stack = vec![root];
     let mut found = Vec::new();
@@ -840,13 +776,13 @@ pub fn relist_tree(dir: &Path, rel: &str) -> Result<(), SweepError> {
             .map(|c| c.as_os_str().to_string_lossy())
             .collect::<Vec<_>>()
             .join("/");
-        files.insert(r, serde_json::to_value(entry).expect("entries serialise"));
+        m.files.insert(r, entry);
     }
-    // Sorted, as the run wrote it.
-    let sorted: BTreeMap<String, Value> = std::mem::take(files).into_iter().collect();
-    *files = sorted.into_iter().collect();
-    let text = serde_json::to_string_pretty(&m).expect("manifests serialise");
-    write_atomic(&dir.join(MANIFEST_FILE), format!("{text}\n").as_bytes())
+    let again = m.to_text();
+    if again == text {
+        return Ok(());
+    }
+    write_atomic(&path, again.as_bytes())
 }
 
 #[cfg(test)]
@@ -890,7 +826,10 @@ mod tests {
         std::fs::write(&p, b"hello").unwrap();
         let e = FileEntry::of(&p).unwrap();
         assert_eq!(e.bytes, 5);
-        assert_eq!(e.fnv1a64, format!("{:016x}", fnv1a64(b"hello")));
+        assert_eq!(
+            e.fnv1a64,
+            format!("{:016x}", whirlmap_core::scene::fnv1a64(b"hello"))
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -38,6 +38,7 @@ pub mod folder;
 pub mod merge;
 pub mod ordered;
 pub mod overrides;
+pub mod pipeline;
 pub mod pool;
 pub mod progress;
 pub mod recheck;

@@ -26,10 +26,9 @@ use crate::folder::{self, Mode, RunFolder, RunIdentity};
 use crate::shard::{read_shard_manifest, spec_hash, Shard, ShardManifest};
 use crate::spec::SpecError;
 use crate::sweep::{
-    io_err, point_key, write_manifest, write_summary, RunMeta, RunRecord, SweepError,
-    MANIFEST_FILE, POINTS_FILE, SUMMARY_FILE, TIMINGS_FILE,
+    io_err, point_key, write_manifest, write_summary, RunMeta, RunRecord, SweepError, POINTS_FILE,
+    SUMMARY_FILE, TIMINGS_FILE,
 };
-use serde_json::{json, Value};
 use std::collections::{BTreeMap, HashMap};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -37,6 +36,7 @@ use thiserror::Error;
 use whirlmap_core::MODEL_VERSION;
 use whirlmap_results::critical::{read_critical, CriticalRow};
 use whirlmap_results::files::{orbit_error_file, orbit_file, CHARTS_DIR, ORBITS_DIR};
+use whirlmap_results::manifest::{ManifestView, MergedShard, TimingRow};
 use whirlmap_results::point::PointLine;
 use whirlmap_results::read::complete_len;
 
@@ -60,15 +60,7 @@ pub enum MergeError {
     Charts(#[from] ChartsFailed),
 }
 
-/// Why the chart drawing handed to [`merge`] failed, as its caller words it.
-#[derive(Debug, Error)]
-#[error("{message}")]
-pub struct ChartsFailed {
-    /// What went wrong.
-    pub message: String,
-    /// Whether an output could not be written (exit code 4) rather than an input read (2).
-    pub output: bool,
-}
+pub use crate::pipeline::ChartsFailed;
 
 impl MergeError {
     /// The process exit code: 2 refused or bad input, 4 an output failed.
@@ -109,7 +101,7 @@ struct ShardDir {
     dir: PathBuf,
     m: ShardManifest,
     /// The shard's `manifest.json` (written when its grid points finished), if readable.
-    finished: Option<Value>,
+    finished: Option<ManifestView>,
 }
 
 impl ShardDir {
@@ -159,9 +151,7 @@ fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardDir>, MergeError> {
         }
         match read_shard_manifest(dir) {
             Ok(m) => {
-                let finished = std::fs::read_to_string(dir.join(MANIFEST_FILE))
-                    .ok()
-                    .and_then(|t| serde_json::from_str(&t).ok());
+                let finished = folder::read_manifest(dir).ok().flatten();
                 shards.push(ShardDir {
                     dir: dir.clone(),
                     m,
@@ -251,7 +241,7 @@ pub fn merge(
     dirs: &[PathBuf],
     out_dir: &Path,
     overwrite: bool,
-    draw_charts: &dyn Fn(&Path) -> Result<Vec<PathBuf>, ChartsFailed>,
+    draw_charts: crate::pipeline::DrawCharts,
 ) -> Result<MergeOutcome, MergeError> {
     let shards = read_shards(dirs)?;
     let spec = shards[0].m.spec.clone();
@@ -624,11 +614,7 @@ pub fn merge(
     });
     record.classes = Some(classes.clone());
     write_manifest(&out, &record, false)?;
-    let charts = if spec.charts.is_empty() {
-        Vec::new()
-    } else {
-        draw_charts(out_dir)?
-    };
+    let charts = crate::pipeline::draw_charts(&spec, out_dir, draw_charts)?.unwrap_or_default();
     out.record_tree(CHARTS_DIR)?;
     record.meta.ended_unix_s = merged_end(&shards);
     write_manifest(&out, &record, true)?;
@@ -649,8 +635,8 @@ fn record_skipped(shards: &[ShardDir]) -> usize {
     shards
         .iter()
         .filter_map(|s| s.finished.as_ref())
-        .filter_map(|m| m.pointer("/counts/skipped").and_then(Value::as_u64))
-        .sum::<u64>() as usize
+        .filter_map(|m| m.counts.as_ref().map(|c| c.skipped))
+        .sum()
 }
 
 /// The latest end time of the shards.
@@ -658,14 +644,13 @@ fn merged_end(shards: &[ShardDir]) -> Option<f64> {
     shards
         .iter()
         .filter_map(|s| s.finished.as_ref())
-        .filter_map(|m| m.get("ended_unix_s").and_then(Value::as_f64))
+        .filter_map(|m| m.ended_unix_s)
         .reduce(f64::max)
 }
 
 /// Run facts of the merged manifest: the earliest start of the shards, their threads summed,
 /// their build (the same in every shard), and the shards.
 fn merged_meta(shards: &[ShardDir]) -> RunMeta {
-    let field = |s: &ShardDir, k: &str| s.finished.as_ref().and_then(|m| m.get(k)).cloned();
     let mut order: Vec<&ShardDir> = shards.iter().collect();
     order.sort_by_key(|s| s.m.shard);
     RunMeta {
@@ -673,40 +658,40 @@ fn merged_meta(shards: &[ShardDir]) -> RunMeta {
         git_commit: order[0].m.git_commit.clone(),
         started_unix_s: shards
             .iter()
-            .filter_map(|s| field(s, "started_unix_s")?.as_f64())
+            .filter_map(|s| s.finished.as_ref()?.started_unix_s)
             .fold(f64::INFINITY, f64::min),
         ended_unix_s: None,
         threads: shards
             .iter()
-            .filter_map(|s| field(s, "threads")?.as_u64())
+            .filter_map(|s| s.finished.as_ref()?.threads)
             .sum::<u64>() as usize,
         shard: None,
-        merged_from: Some(Value::Array(
+        merged_from: Some(
             order
                 .iter()
-                .map(|s| {
-                    json!({"shard": s.m.shard, "shards": s.m.shards, "dir": s.dir.display().to_string(),
-                           "points": s.m.points.len(), "spec_hash": s.m.spec_hash})
+                .map(|s| MergedShard {
+                    dir: s.dir.display().to_string(),
+                    points: s.m.points.len(),
+                    shard: s.m.shard,
+                    shards: s.m.shards,
+                    spec_hash: s.m.spec_hash.clone(),
                 })
                 .collect(),
-        )),
+        ),
     }
 }
 
 /// The shards' `timings.jsonl` lines, in grid order (wall times are not deterministic; this
 /// file is for profiling only).
 fn write_timings(shards: &[ShardDir], path: &Path) -> Result<(), SweepError> {
-    let mut rows: Vec<(u64, String)> = Vec::new();
+    let mut rows: Vec<(usize, String)> = Vec::new();
     for s in shards {
         let Ok(text) = std::fs::read_to_string(s.dir.join(TIMINGS_FILE)) else {
             continue;
         };
         for line in text.lines() {
-            if let Some(i) = serde_json::from_str::<Value>(line)
-                .ok()
-                .and_then(|v| v.get("index").and_then(Value::as_u64))
-            {
-                rows.push((i, line.to_string()));
+            if let Ok(row) = serde_json::from_str::<TimingRow>(line) {
+                rows.push((row.index, line.to_string()));
             }
         }
     }

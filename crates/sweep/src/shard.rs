@@ -13,17 +13,16 @@
 //! `manifest.json` (with a `shard` section), `critical.json` (its friction values only) and
 //! `orbits/`, and, BEFORE it runs anything, [`SHARD_FILE`]: the spec, its hash, the model
 //! version, `I/N` and the indices and keys it owns, so a merge can name what a shard that
-//! died lacks; `complete` in it turns true when everything is written. Charts are drawn by the merge, not by shards.
+//! died lacks; `complete` in it turns true when everything is written. Charts are drawn by the merge, not by shards. A shard runs through
+//! [`crate::pipeline::run`], as a whole sweep does.
 
-use crate::extras::{run_all_owned, ExtrasError};
-use crate::folder::write_atomic;
 use crate::spec::SweepSpec;
-use crate::sweep::{point_key, run_grid, start_run, RunOptions, SweepError, SweepOutcome};
+use crate::sweep::{point_key, SweepError};
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::MODEL_VERSION;
+use whirlmap_results::manifest::ShardTag;
 
 /// The file a shard writes before it runs: [`ShardManifest`].
 pub use whirlmap_results::files::SHARD_FILE;
@@ -80,8 +79,11 @@ impl Shard {
     }
 
     /// The `shard` section of the shard's `manifest.json`.
-    pub fn manifest_tag(&self) -> Value {
-        json!({"index": self.index, "count": self.count})
+    pub fn manifest_tag(&self) -> ShardTag {
+        ShardTag {
+            count: self.count,
+            index: self.index,
+        }
     }
 }
 
@@ -176,68 +178,6 @@ pub fn read_shard_manifest(dir: &Path) -> Result<ShardManifest, String> {
         )
     })?;
     serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// Runs shard `shard` of `spec`: takes the folder ([`crate::folder`]; `opts.resume` continues
-/// only the same shard of the same spec and build), writes [`SHARD_FILE`], runs the owned grid
-/// points, then the owned critical searches and orbit panels, listing every file in the
-/// manifest, which it marks complete at the end.
-pub fn run_shard(
-    spec: &SweepSpec,
-    opts: &RunOptions,
-    shard: Shard,
-) -> Result<(SweepOutcome, Option<PathBuf>), ShardRunError> {
-    let mut run = start_run(spec, opts, Some(&shard))?;
-    let manifest = shard_manifest(spec, shard)?;
-    let path = opts.out_dir.join(SHARD_FILE);
-    let write = |m: &ShardManifest| {
-        let text = serde_json::to_string_pretty(m).expect("shard manifests serialise");
-        write_atomic(&path, format!("{text}\n").as_bytes())
-    };
-    write(&manifest)?;
-    run.record(&path)?;
-    run_grid(spec, opts, Some(&shard), &mut run)?;
-    let progress = opts.progress != crate::sweep::ProgressMode::Off;
-    let x = run_all_owned(spec, &opts.out_dir, opts.threads, progress, |k| {
-        shard.owns(k)
-    })?;
-    for p in x.critical.iter().chain(&x.probability) {
-        run.record(p)?;
-    }
-    if let Some(c) = &x.critical {
-        run.record(&c.with_file_name(crate::extras::CRITICAL_CSV_FILE))?;
-    }
-    run.record(&opts.out_dir.join(whirlmap_results::files::ORBITS_DIR))?;
-    write(&ShardManifest {
-        complete: true,
-        ..manifest
-    })?;
-    run.record(&path)?;
-    let outcome = run.outcome.clone();
-    run.finish()?;
-    Ok((outcome, x.critical))
-}
-
-/// Why a shard could not run or write its outputs.
-#[derive(Debug, thiserror::Error)]
-pub enum ShardRunError {
-    /// As for a whole sweep.
-    #[error(transparent)]
-    Sweep(#[from] SweepError),
-    /// The critical search or the orbits could not be written.
-    #[error(transparent)]
-    Extras(#[from] ExtrasError),
-}
-
-impl ShardRunError {
-    /// The process exit code: 2 bad input or a refused folder (nothing run), 4 an output
-    /// could not be written.
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            ShardRunError::Sweep(e) => e.exit_code(),
-            ShardRunError::Extras(_) => 4,
-        }
-    }
 }
 
 #[cfg(test)]

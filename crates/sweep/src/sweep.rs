@@ -37,14 +37,13 @@
 //! nothing the size of the grid is held but, on a resume, the records read back and those
 //! written since.
 
-use crate::folder::{self, FileEntry, Mode, RunFolder, RunIdentity};
+use crate::folder::{self, Mode, RunFolder, RunIdentity};
 use crate::ordered::{run_ordered, OrderedSink};
 use crate::record::DropRecord;
 use crate::run::{catch_drop, DropFailure};
 use crate::spec::{Grid, Point, SpecError, SweepSpec};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
-use serde_json::Value;
 use std::collections::{BTreeMap, HashMap};
 use std::fs::{File, OpenOptions};
 use std::io::{BufRead, IsTerminal, Read, Write};
@@ -55,7 +54,9 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use thiserror::Error;
 use whirlmap_core::scene::fnv1a64;
 use whirlmap_core::{simulate, DropOptions, Scene, MODEL_VERSION};
+use whirlmap_results::manifest::{Manifest, MergedShard, ShardTag, TimingRow};
 use whirlmap_results::point::PointLine;
+use whirlmap_results::summary::{SummaryRow, SummarySource};
 
 pub use whirlmap_results::files::{MANIFEST_FILE, POINTS_FILE, SUMMARY_FILE, TIMINGS_FILE};
 
@@ -197,42 +198,7 @@ pub struct SweepOutcome {
     pub out_dir: PathBuf,
 }
 
-#[derive(Serialize)]
-struct Manifest<'a> {
-    spec: &'a SweepSpec,
-    /// [`crate::shard::spec_hash`] of `spec`.
-    spec_hash: &'a str,
-    whirlmap_version: &'a str,
-    model_version: u32,
-    /// The commit the binary that ran the drops was built from
-    /// ([`crate::build_info::GIT_COMMIT`]).
-    git_commit: &'a str,
-    /// False while the run is going on (or after it was killed); true once every file is
-    /// written.
-    complete: bool,
-    started_unix_s: f64,
-    ended_unix_s: Option<f64>,
-    threads: usize,
-    counts: Option<&'a Counts>,
-    classes: Option<&'a BTreeMap<String, usize>>,
-    /// A shard run's part of the grid (`crate::shard`); absent for a whole run.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    shard: Option<&'a Value>,
-    /// The shards a merged result was made from (`crate::merge`); absent otherwise.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    merged_from: Option<&'a Value>,
-    /// Every file the run wrote (relative path -> size and FNV-1a 64 hash).
-    files: &'a BTreeMap<String, FileEntry>,
-}
-
-/// The counts of a finished grid.
-#[derive(Debug, Clone, Serialize)]
-pub(crate) struct Counts {
-    pub points: usize,
-    pub ok: usize,
-    pub failed: usize,
-    pub skipped: usize,
-}
+pub(crate) use whirlmap_results::manifest::Counts;
 
 pub(crate) fn unix_now() -> f64 {
     SystemTime::now()
@@ -388,55 +354,6 @@ fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
     Ok(map)
 }
 
-/// Reads the records of a `points.jsonl` as JSON values, skipping a torn or corrupt line
-/// (for charts and tools).
-pub fn read_points(path: &Path) -> std::io::Result<Vec<Value>> {
-    let text = std::fs::read_to_string(path)?;
-    Ok(text
-        .lines()
-        .filter_map(|l| serde_json::from_str(l).ok())
-        .collect())
-}
-
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
-fn json_cell(v: Option<&Value>) -> String {
-    match v {
-        None | Some(Value::Null) => String::new(),
-        Some(Value::String(s)) => csv_field(s),
-        Some(other) => csv_field(&other.to_string()),
-    }
-}
-
-const SUMMARY_FIELDS: &[&str] = &[
-    "class",
-    "first_contact_force_n",
-    "max_contact_force_n",
-    "peak_friction_power_w",
-    "peak_heat_power_w",
-    "whirl_frequency_hz",
-    "contact_duty",
-    "impacts",
-    "end_time_s",
-];
-
-/// What the summary needs of a record line.
-#[derive(serde::Deserialize)]
-struct SummaryLine {
-    #[serde(default)]
-    status: Option<String>,
-    #[serde(default)]
-    record: Option<serde_json::Map<String, Value>>,
-    #[serde(default)]
-    error: Option<Value>,
-}
-
 /// Reads `points.jsonl` (one line per grid point in `indices`' order) and writes
 /// `summary.csv` from it, line by line. Returns (ok, failed, class counts).
 pub(crate) fn write_summary(
@@ -452,11 +369,8 @@ pub(crate) fn write_summary(
     let (mut ok, mut failed) = (0, 0);
     let mut read_error: Option<std::io::Error> = None;
     folder::write_atomic_with(&summary_path, |w| {
-        let mut header = vec!["index".to_string()];
-        header.extend(spec.axes.0.iter().map(|a| csv_field(&a.name)));
-        header.extend(SUMMARY_FIELDS.iter().map(|s| s.to_string()));
-        header.extend(["status".to_string(), "error".to_string()]);
-        writeln!(w, "{}", header.join(","))?;
+        let header = SummaryRow::header(spec.axes.0.iter().map(|a| a.name.as_str()));
+        writeln!(w, "{header}")?;
         for index in indices {
             let line = match lines.next() {
                 Some(Ok(l)) => l,
@@ -466,33 +380,25 @@ pub(crate) fn write_summary(
                 }
                 None => String::new(),
             };
-            let v: Option<SummaryLine> = serde_json::from_str(&line).ok();
-            let mut row = vec![index.to_string()];
-            row.extend(
-                spec.inputs_at(index)
-                    .iter()
-                    .map(|(_, x)| json_cell(Some(&Value::from(*x)))),
-            );
-            let rec = v.as_ref().and_then(|v| v.record.as_ref());
-            for f in SUMMARY_FIELDS {
-                row.push(json_cell(rec.and_then(|r| r.get(*f))));
-            }
-            let status = v.as_ref().and_then(|v| v.status.clone());
-            if status.as_deref() == Some("ok") {
+            let source = SummarySource::parse(&line);
+            if source.as_ref().is_some_and(SummarySource::is_ok) {
                 ok += 1;
-                if let Some(c) = rec.and_then(|r| r.get("class")).and_then(Value::as_str) {
-                    *classes.entry(c.to_string()).or_insert(0) += 1;
+                let class = source
+                    .as_ref()
+                    .and_then(|s| s.record.as_ref())
+                    .and_then(|r| r.class.clone());
+                if let Some(c) = class {
+                    *classes.entry(c).or_insert(0) += 1;
                 }
             } else {
                 failed += 1;
             }
-            row.push(json_cell(status.map(Value::from).as_ref()));
-            row.push(json_cell(
-                v.as_ref()
-                    .and_then(|v| v.error.as_ref())
-                    .and_then(|e| e.get("message")),
-            ));
-            writeln!(w, "{}", row.join(","))?;
+            let row = SummaryRow {
+                index,
+                inputs: spec.inputs_at(index).iter().map(|(_, x)| *x).collect(),
+                source,
+            };
+            writeln!(w, "{}", row.to_csv_line())?;
         }
         Ok(())
     })?;
@@ -512,13 +418,13 @@ pub(crate) struct RunMeta {
     pub started_unix_s: f64,
     pub ended_unix_s: Option<f64>,
     pub threads: usize,
-    pub shard: Option<Value>,
-    pub merged_from: Option<Value>,
+    pub shard: Option<ShardTag>,
+    pub merged_from: Option<Vec<MergedShard>>,
 }
 
 impl RunMeta {
     /// This binary's build, started now.
-    pub fn now(threads: usize, shard: Option<Value>) -> Self {
+    pub fn now(threads: usize, shard: Option<ShardTag>) -> Self {
         Self {
             whirlmap_version: crate::build_info::VERSION.to_string(),
             git_commit: crate::build_info::GIT_COMMIT.to_string(),
@@ -549,24 +455,23 @@ pub(crate) fn write_manifest(
 ) -> Result<(), SweepError> {
     let manifest = Manifest {
         spec: &r.spec,
-        spec_hash: &r.spec_hash,
-        whirlmap_version: &r.meta.whirlmap_version,
+        spec_hash: r.spec_hash.clone(),
+        whirlmap_version: r.meta.whirlmap_version.clone(),
         model_version: MODEL_VERSION,
-        git_commit: &r.meta.git_commit,
+        git_commit: r.meta.git_commit.clone(),
         complete,
         started_unix_s: r.meta.started_unix_s,
         ended_unix_s: r.meta.ended_unix_s,
         threads: r.meta.threads,
-        counts: r.counts.as_ref(),
-        classes: r.classes.as_ref(),
-        shard: r.meta.shard.as_ref(),
-        merged_from: r.meta.merged_from.as_ref(),
-        files: folder.files(),
+        counts: r.counts.clone(),
+        classes: r.classes.clone(),
+        shard: r.meta.shard,
+        merged_from: r.meta.merged_from.clone(),
+        files: folder.files().clone(),
     };
-    let text = serde_json::to_string_pretty(&manifest).expect("manifest serialises");
     folder::write_atomic(
         &folder.dir().join(MANIFEST_FILE),
-        format!("{text}\n").as_bytes(),
+        manifest.to_text().as_bytes(),
     )
 }
 
@@ -636,7 +541,7 @@ pub fn start_run(
     let id = RunIdentity {
         spec,
         spec_hash: spec_hash.clone(),
-        shard: tag.clone(),
+        shard: tag,
     };
     let what = match shard {
         Some(s) => format!("sweep --shard {} --shards {}", s.index, s.count),
@@ -762,9 +667,13 @@ impl OrderedSink<GridJob> for GridWriter<'_> {
             let line = r.to_line();
             text.push_str(&line);
             text.push('\n');
-            let t =
-                serde_json::json!({"key": r.key, "index": r.index, "wall_time_s": r.wall_time_s});
-            times.push_str(&format!("{t}\n"));
+            let t = TimingRow {
+                index: r.index,
+                key: r.key.clone(),
+                wall_time_s: r.wall_time_s,
+            };
+            times.push_str(&t.to_line());
+            times.push('\n');
             if let Some(fresh) = &mut self.fresh {
                 fresh.insert(
                     r.key.clone(),
@@ -948,6 +857,26 @@ pub fn run_grid(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_summary_of_committed_records_is_the_committed_summary() {
+        for name in ["paper", "paper-radial"] {
+            let src = Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../results")
+                .join(name);
+            let spec = folder::manifest_spec(&src).expect("a committed manifest");
+            let dir = std::env::temp_dir()
+                .join(format!("whirlmap-summary-{name}-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::copy(src.join(POINTS_FILE), dir.join(POINTS_FILE)).unwrap();
+            let n = spec.grid().unwrap().len();
+            write_summary(&spec, &dir, &mut (0..n)).unwrap();
+            let made = std::fs::read(dir.join(SUMMARY_FILE)).unwrap();
+            let committed = std::fs::read(src.join(SUMMARY_FILE)).unwrap();
+            assert!(made == committed, "{name}: summary.csv differs");
+            std::fs::remove_dir_all(&dir).ok();
+        }
+    }
 
     fn point(scene: Scene) -> Point {
         Point {

@@ -1,0 +1,348 @@
+//! One harness for the steppers' order and tolerance: every stepper (DOPRI5, DOP853,
+//! ROS34PW2) runs a set of reference problems with closed-form solutions, and for each the
+//! harness checks
+//!
+//! - the observed convergence order on fixed steps (the error of `h` against `h / 2`) is the
+//!   method's order, and
+//! - tolerance proportionality: with adaptive steps the global error falls as `rtol`
+//!   tightens, stays within a small multiple of `rtol`, and falls at a rate close to `rtol`'s.
+//!
+//! The problems: exponential decay at two rates, the harmonic oscillator, for the implicit
+//! stepper also the harmonic oscillator with a deliberately wrong Jacobian (a W-method keeps
+//! its order with any matrix) and a stiff linear system (eigenvalues -1 and -1000) whose
+//! solution lies on the slow manifold.
+
+use whirlmap_core::ode::{
+    integrate, Dop853, Dopri5, NoGuard, NoObserver, OdeSystem, Ros34pw2, StepControl, Stepper,
+    StiffJacobian, Stop,
+};
+
+/// A reference problem: a two-component system with its exact solution.
+trait Reference: OdeSystem<2, Guard = NoGuard> {
+    /// Its name, for messages.
+    fn name(&self) -> &'static str;
+    /// The state at time 0.
+    fn y0(&self) -> [f64; 2];
+    /// The exact solution at `t`.
+    fn exact(&self, t: f64) -> [f64; 2];
+    /// The time the runs end at.
+    fn t_end(&self) -> f64;
+}
+
+/// y0' = -2 y0, y1' = -y1 / 2: exp(-2 t), exp(-t / 2).
+struct Decay;
+impl OdeSystem<2> for Decay {
+    type Guard = NoGuard;
+    fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+        dy[0] = -2.0 * y[0];
+        dy[1] = -0.5 * y[1];
+    }
+    fn stiff_jacobian(&self, _t: f64, _y: &[f64; 2]) -> Option<StiffJacobian> {
+        let mut s = StiffJacobian::over(&[0, 1]);
+        s.jac[(0, 0)] = -2.0;
+        s.jac[(1, 1)] = -0.5;
+        Some(s)
+    }
+}
+impl Reference for Decay {
+    fn name(&self) -> &'static str {
+        "exponential decay"
+    }
+    fn y0(&self) -> [f64; 2] {
+        [1.0, 1.0]
+    }
+    fn exact(&self, t: f64) -> [f64; 2] {
+        [(-2.0 * t).exp(), (-0.5 * t).exp()]
+    }
+    fn t_end(&self) -> f64 {
+        3.0
+    }
+}
+
+/// x'' = -x as a first-order system: cos t, -sin t. `wrong_jacobian` hands the implicit
+/// stepper a matrix that is not the Jacobian.
+struct Harmonic {
+    wrong_jacobian: bool,
+}
+impl OdeSystem<2> for Harmonic {
+    type Guard = NoGuard;
+    fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+        dy[0] = y[1];
+        dy[1] = -y[0];
+    }
+    fn stiff_jacobian(&self, _t: f64, _y: &[f64; 2]) -> Option<StiffJacobian> {
+        let mut s = StiffJacobian::over(&[0, 1]);
+        if self.wrong_jacobian {
+            s.jac[(1, 0)] = -3.0;
+            s.jac[(0, 0)] = 0.7;
+        } else {
+            s.jac[(0, 1)] = 1.0;
+            s.jac[(1, 0)] = -1.0;
+        }
+        Some(s)
+    }
+}
+impl Reference for Harmonic {
+    fn name(&self) -> &'static str {
+        if self.wrong_jacobian {
+            "harmonic oscillator, wrong Jacobian"
+        } else {
+            "harmonic oscillator"
+        }
+    }
+    fn y0(&self) -> [f64; 2] {
+        [1.0, 0.0]
+    }
+    fn exact(&self, t: f64) -> [f64; 2] {
+        [t.cos(), -t.sin()]
+    }
+    fn t_end(&self) -> f64 {
+        4.0
+    }
+}
+
+/// y0' = -y0, y1' = -1000 (y1 - y0) - y0: both exp(-t) from y(0) = (1, 1); the eigenvalue
+/// -1000 makes it stiff (an explicit stepper's step would be bound to ~3e-3).
+struct StiffLinear;
+const STIFF: f64 = 1000.0;
+impl OdeSystem<2> for StiffLinear {
+    type Guard = NoGuard;
+    fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+        dy[0] = -y[0];
+        dy[1] = -STIFF * (y[1] - y[0]) - y[0];
+    }
+    fn stiff_jacobian(&self, _t: f64, _y: &[f64; 2]) -> Option<StiffJacobian> {
+        let mut s = StiffJacobian::over(&[0, 1]);
+        s.jac[(0, 0)] = -1.0;
+        s.jac[(1, 0)] = STIFF - 1.0;
+        s.jac[(1, 1)] = -STIFF;
+        Some(s)
+    }
+}
+impl Reference for StiffLinear {
+    fn name(&self) -> &'static str {
+        "stiff linear system"
+    }
+    fn y0(&self) -> [f64; 2] {
+        [1.0, 1.0]
+    }
+    fn exact(&self, t: f64) -> [f64; 2] {
+        [(-t).exp(); 2]
+    }
+    fn t_end(&self) -> f64 {
+        2.0
+    }
+}
+
+/// A stepper under test: how to make one, its order, the fixed steps at which its error is
+/// well above rounding and well inside the asymptotic range, and the tolerances to sweep.
+struct Method {
+    name: &'static str,
+    order: f64,
+    make: fn(StepControl<2>) -> Box<dyn StepperBox>,
+    /// Fixed step counts over `t_end`: the order is measured between `n` and `2 n`.
+    steps: usize,
+    /// Tolerances, loosest first.
+    rtols: [f64; 3],
+    /// Whether it runs the stiff problems.
+    implicit: bool,
+}
+
+/// Object-safe wrapper over the steppers: one run of a reference problem to its end.
+trait StepperBox {
+    fn run(&mut self, p: &dyn ReferenceDyn) -> [f64; 2];
+}
+
+/// [`Reference`] as a trait object, dispatching to the concrete problem.
+trait ReferenceDyn {
+    fn reference(&self) -> Problem<'_>;
+}
+
+/// The reference problems, by kind (the steppers are generic over the system).
+enum Problem<'a> {
+    Decay(&'a Decay),
+    Harmonic(&'a Harmonic),
+    Stiff(&'a StiffLinear),
+}
+
+impl ReferenceDyn for Decay {
+    fn reference(&self) -> Problem<'_> {
+        Problem::Decay(self)
+    }
+}
+impl ReferenceDyn for Harmonic {
+    fn reference(&self) -> Problem<'_> {
+        Problem::Harmonic(self)
+    }
+}
+impl ReferenceDyn for StiffLinear {
+    fn reference(&self) -> Problem<'_> {
+        Problem::Stiff(self)
+    }
+}
+
+fn run_to_end<M: Stepper<2>, P: Reference>(st: &mut M, p: &P) -> [f64; 2] {
+    let (mut t, mut y) = (0.0, p.y0());
+    let stop = integrate(p, st, &mut t, &mut y, p.t_end(), &mut NoObserver)
+        .unwrap_or_else(|e| panic!("{}: {e}", p.name()));
+    assert!(matches!(stop, Stop::EndTime), "{}: {stop:?}", p.name());
+    assert_eq!(t, p.t_end());
+    y
+}
+
+impl<M: Stepper<2>> StepperBox for M {
+    fn run(&mut self, p: &dyn ReferenceDyn) -> [f64; 2] {
+        match p.reference() {
+            Problem::Decay(p) => run_to_end(self, p),
+            Problem::Harmonic(p) => run_to_end(self, p),
+            Problem::Stiff(p) => run_to_end(self, p),
+        }
+    }
+}
+
+fn methods() -> [Method; 3] {
+    [
+        Method {
+            name: "DOPRI5",
+            order: 5.0,
+            make: |c| Box::new(Dopri5::new(c)),
+            steps: 40,
+            rtols: [1e-4, 1e-7, 1e-10],
+            implicit: false,
+        },
+        Method {
+            name: "DOP853",
+            order: 8.0,
+            make: |c| Box::new(Dop853::new(c)),
+            steps: 10,
+            rtols: [1e-6, 1e-9, 1e-12],
+            implicit: false,
+        },
+        Method {
+            name: "ROS34PW2",
+            order: 3.0,
+            make: |c| Box::new(Ros34pw2::new(c)),
+            steps: 200,
+            rtols: [1e-4, 1e-6, 1e-8],
+            implicit: true,
+        },
+    ]
+}
+
+/// One reference problem as a method runs it: its name, the system, and the exact state at
+/// the end time.
+struct Case {
+    name: &'static str,
+    problem: Box<dyn ReferenceDyn>,
+    exact: [f64; 2],
+    t_end: f64,
+}
+
+impl Case {
+    fn of<P: Reference + ReferenceDyn + 'static>(p: P) -> Self {
+        Case {
+            name: p.name(),
+            exact: p.exact(p.t_end()),
+            t_end: p.t_end(),
+            problem: Box::new(p),
+        }
+    }
+}
+
+/// The problems a method runs.
+fn problems(m: &Method) -> Vec<Case> {
+    let mut v = vec![
+        Case::of(Decay),
+        Case::of(Harmonic {
+            wrong_jacobian: false,
+        }),
+    ];
+    if m.implicit {
+        v.push(Case::of(Harmonic {
+            wrong_jacobian: true,
+        }));
+        v.push(Case::of(StiffLinear));
+    }
+    v
+}
+
+/// The error norm of the whole state, so that a zero of one component cannot fake an order.
+fn error(y: [f64; 2], exact: [f64; 2]) -> f64 {
+    ((y[0] - exact[0]).powi(2) + (y[1] - exact[1]).powi(2)).sqrt()
+}
+
+#[test]
+fn fixed_steps_converge_at_each_methods_order() {
+    for m in methods() {
+        for Case {
+            name,
+            problem: p,
+            exact,
+            t_end,
+        } in problems(&m)
+        {
+            let err_at = |n: usize| {
+                let ctl = StepControl {
+                    rtol: 1.0,
+                    atol: [1.0; 2],
+                    h_min: 0.0,
+                    max_attempts: u64::MAX,
+                    fixed_step: Some(t_end / n as f64),
+                };
+                error((m.make)(ctl).run(p.as_ref()), exact)
+            };
+            let (e1, e2) = (err_at(m.steps), err_at(2 * m.steps));
+            let order = (e1 / e2).log2();
+            assert!(
+                (order - m.order).abs() < 0.1 * m.order,
+                "{} on {name}: observed order {order:.2}, expected {} ({e1:e} -> {e2:e})",
+                m.name,
+                m.order
+            );
+        }
+    }
+}
+
+#[test]
+fn global_error_falls_in_proportion_to_the_tolerance() {
+    for m in methods() {
+        for Case {
+            name,
+            problem: p,
+            exact,
+            ..
+        } in problems(&m)
+        {
+            let errs: Vec<f64> = m
+                .rtols
+                .iter()
+                .map(|&rtol| {
+                    let ctl = StepControl {
+                        rtol,
+                        atol: [rtol * 1e-3; 2],
+                        h_min: 1e-14,
+                        max_attempts: 10_000_000,
+                        fixed_step: None,
+                    };
+                    error((m.make)(ctl).run(p.as_ref()), exact)
+                })
+                .collect();
+            for (rtol, e) in m.rtols.iter().zip(&errs) {
+                assert!(
+                    *e < 100.0 * rtol,
+                    "{} on {name}: rtol {rtol:e} gave error {e:e}",
+                    m.name
+                );
+            }
+            // The error falls at a rate close to the tolerance's: its slope against rtol on
+            // a log scale, from the loosest to the tightest.
+            let slope = (errs[0] / errs[2]).ln() / (m.rtols[0] / m.rtols[2]).ln();
+            assert!(
+                errs[1] < errs[0] && errs[2] < errs[1] && (0.8..=1.2).contains(&slope),
+                "{} on {name}: errors {errs:?} for rtol {:?} (slope {slope:.2})",
+                m.name,
+                m.rtols
+            );
+        }
+    }
+}

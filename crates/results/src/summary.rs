@@ -1,0 +1,158 @@
+//! The lines of `summary.csv`: one row per grid point, made from its line of `points.jsonl`
+//! ([`SummarySource`], read tolerantly) and written as CSV ([`SummaryRow`]). Numbers keep the
+//! form they have in the record (an integer stays an integer), so the summary of a merged
+//! result is byte-identical to a single run's.
+
+use serde::de::IgnoredAny;
+use serde::Deserialize;
+use serde_json::Number;
+
+/// The record fields of a summary row, in column order, after the inputs.
+pub const SUMMARY_FIELDS: &[&str] = &[
+    "class",
+    "first_contact_force_n",
+    "max_contact_force_n",
+    "peak_friction_power_w",
+    "peak_heat_power_w",
+    "whirl_frequency_hz",
+    "contact_duty",
+    "impacts",
+    "end_time_s",
+];
+
+/// What the summary needs of a drop record.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+pub struct SummaryRecord {
+    /// Orbit class name.
+    #[serde(default)]
+    pub class: Option<String>,
+    /// First contact force (N).
+    #[serde(default)]
+    pub first_contact_force_n: Option<Number>,
+    /// Maximum contact force (N).
+    #[serde(default)]
+    pub max_contact_force_n: Option<Number>,
+    /// Peak friction power (W).
+    #[serde(default)]
+    pub peak_friction_power_w: Option<Number>,
+    /// Peak heat power (W).
+    #[serde(default)]
+    pub peak_heat_power_w: Option<Number>,
+    /// Whirl frequency (Hz).
+    #[serde(default)]
+    pub whirl_frequency_hz: Option<Number>,
+    /// Contact duty on the final window.
+    #[serde(default)]
+    pub contact_duty: Option<Number>,
+    /// Impacts.
+    #[serde(default)]
+    pub impacts: Option<Number>,
+    /// Simulated end time (s).
+    #[serde(default)]
+    pub end_time_s: Option<Number>,
+}
+
+/// A point's error: an object with a `message`, or anything else (no message).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum SummaryError {
+    /// `{"message": ...}` (other fields ignored).
+    Object {
+        /// The message, if text.
+        #[serde(default)]
+        message: Option<String>,
+    },
+    /// Text or any other value: no message.
+    Other(IgnoredAny),
+}
+
+/// What the summary needs of a line of `points.jsonl`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+pub struct SummarySource {
+    /// `ok` or `failed`.
+    #[serde(default)]
+    pub status: Option<String>,
+    /// The drop record.
+    #[serde(default)]
+    pub record: Option<SummaryRecord>,
+    /// The error of a failed point.
+    #[serde(default)]
+    pub error: Option<SummaryError>,
+}
+
+impl SummarySource {
+    /// Reads a line; `None` for a line that is not a record (a missing or torn one).
+    pub fn parse(line: &str) -> Option<Self> {
+        serde_json::from_str(line).ok()
+    }
+
+    /// Whether the point ran ok.
+    pub fn is_ok(&self) -> bool {
+        self.status.as_deref() == Some("ok")
+    }
+}
+
+/// One row of `summary.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SummaryRow {
+    /// Grid index.
+    pub index: usize,
+    /// The point's inputs in axis order.
+    pub inputs: Vec<f64>,
+    /// What its line of `points.jsonl` says; `None` when there is no such line.
+    pub source: Option<SummarySource>,
+}
+
+impl SummaryRow {
+    /// The header: `index`, the axis names, [`SUMMARY_FIELDS`], `status`, `error`.
+    pub fn header<'a>(axes: impl IntoIterator<Item = &'a str>) -> String {
+        let mut h = vec!["index".to_string()];
+        h.extend(axes.into_iter().map(csv_field));
+        h.extend(SUMMARY_FIELDS.iter().map(|s| s.to_string()));
+        h.extend(["status".to_string(), "error".to_string()]);
+        h.join(",")
+    }
+
+    /// The row as a CSV line (without its newline): a missing value is an empty cell, a
+    /// non-finite input too.
+    pub fn to_csv_line(&self) -> String {
+        let mut row = vec![self.index.to_string()];
+        row.extend(
+            self.inputs
+                .iter()
+                .map(|x| Number::from_f64(*x).map_or(String::new(), |n| csv_field(&n.to_string()))),
+        );
+        let rec = self.source.as_ref().and_then(|s| s.record.as_ref());
+        let num = |n: Option<&Number>| n.map_or(String::new(), |n| csv_field(&n.to_string()));
+        let text = |s: Option<&String>| s.map_or(String::new(), |s| csv_field(s));
+        row.push(text(rec.and_then(|r| r.class.as_ref())));
+        for n in [
+            rec.and_then(|r| r.first_contact_force_n.as_ref()),
+            rec.and_then(|r| r.max_contact_force_n.as_ref()),
+            rec.and_then(|r| r.peak_friction_power_w.as_ref()),
+            rec.and_then(|r| r.peak_heat_power_w.as_ref()),
+            rec.and_then(|r| r.whirl_frequency_hz.as_ref()),
+            rec.and_then(|r| r.contact_duty.as_ref()),
+            rec.and_then(|r| r.impacts.as_ref()),
+            rec.and_then(|r| r.end_time_s.as_ref()),
+        ] {
+            row.push(num(n));
+        }
+        row.push(text(self.source.as_ref().and_then(|s| s.status.as_ref())));
+        let message = match self.source.as_ref().and_then(|s| s.error.as_ref()) {
+            Some(SummaryError::Object { message }) => message.as_ref(),
+            _ => None,
+        };
+        row.push(text(message));
+        row.join(",")
+    }
+}
+
+/// A CSV cell: quoted when it holds a comma, a quote or a line break.
+pub fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
