@@ -112,8 +112,9 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
     let start = Instant::now();
     let label = format!("critical search, {} friction coefficient(s)", a.mu.len());
     let ticker = Ticker::new(&label, 0, !a.no_progress);
-    let mut rows =
-        critical_rows_ticked(&base, &a.mu, &opts, &ticker).map_err(|e| Failure::Input(e.into()))?;
+    let rows = critical_rows_ticked(&base, &a.mu, &opts, &ticker);
+    ticker.finish();
+    let mut rows = rows.map_err(|e| Failure::Input(e.into()))?;
     if let Some(tighter) = a.fidelity.and_then(|f| f.tighter()) {
         let drop_opts = whirlmap_core::DropOptions {
             duration_s: a.duration_s,

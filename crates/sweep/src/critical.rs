@@ -541,7 +541,7 @@ pub fn critical_rows(
 
 /// [`critical_rows`], counting every finished drop on `ticker` (progress for a search that
 /// takes seconds); the ticker expects the scan's drops and learns the bisections' as they
-/// come.
+/// come. The caller finishes the ticker (it may count other drops too).
 pub fn critical_rows_ticked(
     base: &Scene,
     mus: &[f64],
@@ -575,7 +575,6 @@ pub fn critical_rows_ticked(
         scenes.len(),
         o,
     )?;
-    ticker.finish();
     Ok(results
         .into_iter()
         .zip(mus.iter().zip(&scenes))

@@ -1,7 +1,8 @@
 //! What a sweep spec asks for beside its grid: the critical-speed search (`critical.json`)
 //! and the orbits of the Fig. 3 chart (`orbits/*.json`), in the forms the charts (`whirlmap-plot`) read.
 
-use crate::critical::{critical_rows, csv_text, CriticalRow};
+use crate::critical::{critical_rows_ticked, csv_text, CriticalRow};
+use crate::progress::Ticker;
 use crate::run::run_drop;
 use crate::spec::SweepSpec;
 use rayon::prelude::*;
@@ -89,13 +90,20 @@ pub fn run_all_owned(
     progress: bool,
     owns: impl Fn(usize) -> bool + Sync,
 ) -> Result<ExtrasWritten, ExtrasError> {
+    let ticker = Ticker::new(
+        &format!("sweep {}: critical search and orbits", spec.name),
+        orbit_panels(spec).map_or(0, |(_, mus)| mus.len()),
+        progress && (spec.critical.is_some() || orbit_panels(spec).is_some()),
+    );
     let work = || -> Result<_, ExtrasError> {
         let ((critical, orbits), probability) = rayon::join(
             || {
-                rayon::join(
-                    || run_critical_owned(spec, out_dir, &owns),
-                    || record_orbits_owned(spec, out_dir, &owns),
-                )
+                let both = rayon::join(
+                    || run_critical_ticked(spec, out_dir, &owns, &ticker),
+                    || record_orbits_ticked(spec, out_dir, &owns, &ticker),
+                );
+                ticker.finish();
+                both
             },
             || {
                 if owns(0) {
@@ -162,6 +170,16 @@ pub fn run_critical_owned(
     out_dir: &Path,
     owns: impl Fn(usize) -> bool,
 ) -> Result<Option<PathBuf>, ExtrasError> {
+    run_critical_ticked(spec, out_dir, owns, &Ticker::off())
+}
+
+/// [`run_critical_owned`], counting its drops on `ticker`.
+fn run_critical_ticked(
+    spec: &SweepSpec,
+    out_dir: &Path,
+    owns: impl Fn(usize) -> bool,
+    ticker: &Ticker,
+) -> Result<Option<PathBuf>, ExtrasError> {
     let Some(c) = &spec.critical else {
         return Ok(None);
     };
@@ -173,8 +191,13 @@ pub fn run_critical_owned(
         Vec::new()
     } else {
         // The spec was validated before anything ran, so this cannot fail.
-        critical_rows(&spec.base_scene(), &mus, &c.options(spec.duration_s))
-            .expect("the spec's critical section was validated")
+        critical_rows_ticked(
+            &spec.base_scene(),
+            &mus,
+            &c.options(spec.duration_s),
+            ticker,
+        )
+        .expect("the spec's critical section was validated")
     };
     write_critical(out_dir, &rows)
 }
@@ -229,6 +252,16 @@ pub fn record_orbits_owned(
     out_dir: &Path,
     owns: impl Fn(usize) -> bool,
 ) -> Result<Vec<PathBuf>, ExtrasError> {
+    record_orbits_ticked(spec, out_dir, owns, &Ticker::off())
+}
+
+/// [`record_orbits_owned`], counting its drops on `ticker`.
+fn record_orbits_ticked(
+    spec: &SweepSpec,
+    out_dir: &Path,
+    owns: impl Fn(usize) -> bool,
+    ticker: &Ticker,
+) -> Result<Vec<PathBuf>, ExtrasError> {
     let Some((speed, mus)) = orbit_panels(spec) else {
         return Ok(Vec::new());
     };
@@ -249,7 +282,9 @@ pub fn record_orbits_owned(
                 orbit_points: Some(20_000),
                 ..Default::default()
             };
-            (i, mu, run_drop(&scene, &opts))
+            let run = run_drop(&scene, &opts);
+            ticker.tick();
+            (i, mu, run)
         })
         .collect();
     let mut written = Vec::new();
