@@ -176,6 +176,18 @@ fn scene_file_with_unknown_key_reports_line_and_column() {
     assert!(err.contains("did you mean `clearance_m`?"), "{err}");
 }
 
+/// A 0.02 s drop of the scene file `p`, as JSON.
+fn short_drop_from(p: &std::path::Path) -> std::process::Output {
+    whirlmap(&[
+        "drop",
+        "--scene",
+        p.to_str().unwrap(),
+        "--duration-s",
+        "0.02",
+        "--json",
+    ])
+}
+
 #[test]
 fn scene_prints_every_field_the_schema_lists_and_the_schema_says_units_and_ranges() {
     let scene: serde_json::Value = serde_json::from_slice(&whirlmap(&["scene"]).stdout).unwrap();
@@ -211,14 +223,7 @@ fn scene_prints_every_field_the_schema_lists_and_the_schema_says_units_and_range
     // every printed field is accepted back: the full file is the default scene
     let p = temp_path("full-scene.json");
     std::fs::write(&p, serde_json::to_string(&scene).unwrap()).unwrap();
-    let a = whirlmap(&[
-        "drop",
-        "--scene",
-        p.to_str().unwrap(),
-        "--duration-s",
-        "0.02",
-        "--json",
-    ]);
+    let a = short_drop_from(&p);
     let b = whirlmap(&["drop", "--duration-s", "0.02", "--json"]);
     assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
     assert_eq!(a.stdout, b.stdout);
@@ -233,14 +238,7 @@ fn printed_scene_round_trips_through_a_scene_file() {
     v["speed_rpm"] = serde_json::json!(3000.0);
     let p = temp_path("scene.json");
     std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
-    let a = whirlmap(&[
-        "drop",
-        "--scene",
-        p.to_str().unwrap(),
-        "--duration-s",
-        "0.02",
-        "--json",
-    ]);
+    let a = short_drop_from(&p);
     let b = whirlmap(&[
         "drop",
         "--speed-rpm",
