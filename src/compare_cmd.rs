@@ -4,6 +4,7 @@
 //! being written or holding a file its run did not write, a bad option, an unwritable
 //! report). Differences between the two specs are always printed.
 
+use crate::{CmdResult, Done, Failure};
 use std::path::PathBuf;
 use whirlmap_sweep::compare::{compare, write_report, ClassMap, Thresholds};
 
@@ -26,23 +27,14 @@ pub struct CompareArgs {
     out: Option<PathBuf>,
 }
 
-/// Runs the subcommand and returns the process exit code.
-pub fn run(a: &CompareArgs) -> u8 {
+/// Runs the subcommand: `Flagged` (exit 1) when the runs differ.
+pub fn run(a: &CompareArgs) -> CmdResult {
     let t = Thresholds {
         force_rel: a.force_rel,
         power_rel: a.power_rel,
     };
-    if let Err(e) = t.validate() {
-        errln!("error: {e}");
-        return 2;
-    }
-    let c = match compare(&a.baseline, &a.new, t) {
-        Ok(c) => c,
-        Err(e) => {
-            errln!("error: {e}");
-            return 2;
-        }
-    };
+    t.validate().map_err(|e| Failure::coded(2, e))?;
+    let c = compare(&a.baseline, &a.new, t).map_err(|e| Failure::coded(2, e))?;
     for w in &c.warnings {
         errln!("warning: {w}");
     }
@@ -51,13 +43,7 @@ pub fn run(a: &CompareArgs) -> u8 {
         whirlmap_plot::classes::draw_marked_class_map(m.path, m.grid, m.title, m.marked)
             .map_err(|e| e.to_string())
     };
-    let png = match write_report(&c, &out, &draw) {
-        Ok(p) => p,
-        Err(e) => {
-            errln!("error: {e}");
-            return 2;
-        }
-    };
+    let png = write_report(&c, &out, &draw).map_err(|e| Failure::coded(2, e))?;
     outln!(
         "compare: {}: {} of {} points and {} of {} critical speeds changed{}",
         if c.changed() { "CHANGED" } else { "same" },
@@ -85,9 +71,5 @@ pub fn run(a: &CompareArgs) -> u8 {
     }
     outln!("  report           {}", out.display());
     outln!("  class map        {}", png.display());
-    if c.changed() {
-        1
-    } else {
-        0
-    }
+    Ok(Done::flagged_if(c.changed()))
 }

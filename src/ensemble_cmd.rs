@@ -4,6 +4,7 @@
 //! Exit codes: 0 ok; 1 some drop failed (outputs still written); 2 bad file or unwritable
 //! output folder (nothing run); 4 an output could not be written.
 
+use crate::{CmdResult, Done, Failure};
 use std::path::PathBuf;
 use whirlmap_sweep::adaptive::run_adaptive;
 use whirlmap_sweep::ensemble::{self, run_ensemble};
@@ -34,37 +35,28 @@ pub struct EnsembleArgs {
     compare_full: bool,
 }
 
-fn code(e: &SweepError) -> u8 {
-    e.exit_code()
+/// The command's failure for a library error.
+fn failure(e: SweepError) -> Failure {
+    Failure::coded(e.exit_code(), e)
 }
 
 /// Reads the file and takes the output folder's lock (one writer at a time; released when the
 /// returned lock is dropped, or the process ends).
-fn load(a: &EnsembleArgs, what: &str) -> Result<(ensemble::EnsembleSpec, PathBuf, FolderLock), u8> {
-    match ensemble::load(&a.file) {
-        Ok(s) => {
-            let out = a
-                .out
-                .clone()
-                .unwrap_or_else(|| PathBuf::from("results").join(&s.name));
-            if let Err(e) = crate::refuse_existing_results(&out, a.overwrite) {
-                errln!("error: {e}");
-                return Err(2);
-            }
-            let lock = std::fs::create_dir_all(&out)
-                .map_err(|e| whirlmap_sweep::folder::output_error(&out, e))
-                .and_then(|_| FolderLock::acquire(&out, what))
-                .map_err(|e| {
-                    errln!("error: {e}");
-                    e.exit_code()
-                })?;
-            Ok((s, out, lock))
-        }
-        Err(e) => {
-            errln!("error: {e}");
-            Err(2)
-        }
-    }
+fn load(
+    a: &EnsembleArgs,
+    what: &str,
+) -> Result<(ensemble::EnsembleSpec, PathBuf, FolderLock), Failure> {
+    let s = ensemble::load(&a.file).map_err(|e| Failure::coded(2, e))?;
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("results").join(&s.name));
+    crate::refuse_existing_results(&out, a.overwrite).map_err(Failure::Input)?;
+    let lock = std::fs::create_dir_all(&out)
+        .map_err(|e| whirlmap_sweep::folder::output_error(&out, e))
+        .and_then(|_| FolderLock::acquire(&out, what))
+        .map_err(failure)?;
+    Ok((s, out, lock))
 }
 
 fn fmt_speed(v: Option<f64>) -> String {
@@ -72,18 +64,10 @@ fn fmt_speed(v: Option<f64>) -> String {
 }
 
 /// Runs `whirlmap ensemble`.
-pub fn run_ensemble_cmd(a: &EnsembleArgs) -> u8 {
-    let (spec, out, _lock) = match load(a, "ensemble") {
-        Ok(x) => x,
-        Err(c) => return c,
-    };
-    let o = match run_ensemble(&spec, &out, a.threads.map(|n| n as usize), !a.no_progress) {
-        Ok(o) => o,
-        Err(e) => {
-            errln!("error: {e}");
-            return code(&e);
-        }
-    };
+pub fn run_ensemble_cmd(a: &EnsembleArgs) -> CmdResult {
+    let (spec, out, _lock) = load(a, "ensemble")?;
+    let o = run_ensemble(&spec, &out, a.threads.map(|n| n as usize), !a.no_progress)
+        .map_err(failure)?;
     outln!(
         "ensemble {}: {} cells x {} members = {} drops, {} failed",
         spec.name,
@@ -122,39 +106,23 @@ pub fn run_ensemble_cmd(a: &EnsembleArgs) -> u8 {
         };
         outln!("  {label}: {} r/min{flag}", levels.join(", "));
     }
-    match whirlmap_plot::probability::render_probability(&out) {
-        Ok(w) => outln!("  output           {} ({} charts)", out.display(), w.len()),
-        Err(e) => {
-            errln!("error: charts: {e}");
-            return 4;
-        }
-    }
-    if o.failed > 0 {
-        1
-    } else {
-        0
-    }
+    let w = whirlmap_plot::probability::render_probability(&out)
+        .map_err(|e| Failure::coded(4, format!("charts: {e}")))?;
+    outln!("  output           {} ({} charts)", out.display(), w.len());
+    Ok(Done::flagged_if(o.failed > 0))
 }
 
 /// Runs `whirlmap adaptive`.
-pub fn run_adaptive_cmd(a: &EnsembleArgs) -> u8 {
-    let (spec, out, _lock) = match load(a, "adaptive") {
-        Ok(x) => x,
-        Err(c) => return c,
-    };
-    let (r, path) = match run_adaptive(
+pub fn run_adaptive_cmd(a: &EnsembleArgs) -> CmdResult {
+    let (spec, out, _lock) = load(a, "adaptive")?;
+    let (r, path) = run_adaptive(
         &spec,
         &out,
         a.threads.map(|n| n as usize),
         a.compare_full,
         !a.no_progress,
-    ) {
-        Ok(x) => x,
-        Err(e) => {
-            errln!("error: {e}");
-            return code(&e);
-        }
-    };
+    )
+    .map_err(failure)?;
     outln!(
         "adaptive {}: {} of {} drops ({:.1} %) for a {} x {} grid from a {} x {} seed, {} rounds, {} boundary cells",
         r.name,
@@ -176,9 +144,7 @@ pub fn run_adaptive_cmd(a: &EnsembleArgs) -> u8 {
         );
     }
     outln!("  output           {}", path.display());
-    if r.evaluated.iter().any(|c| c.p_whirl.is_nan()) {
-        1
-    } else {
-        0
-    }
+    Ok(Done::flagged_if(
+        r.evaluated.iter().any(|c| c.p_whirl.is_nan()),
+    ))
 }

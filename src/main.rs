@@ -218,7 +218,42 @@ enum Failure {
     Output(anyhow::Error),
 }
 
+/// How a command that ran to its end went: exit 0, or exit 1 when the work finished but
+/// flags something (some points failed; `compare`: the runs differ).
+pub(crate) enum Done {
+    /// Exit 0.
+    Clean,
+    /// Exit 1.
+    Flagged,
+}
+
+impl Done {
+    /// `Flagged` when `flag`, else `Clean`.
+    pub(crate) fn flagged_if(flag: bool) -> Self {
+        if flag {
+            Done::Flagged
+        } else {
+            Done::Clean
+        }
+    }
+}
+
+/// What every command returns; [`run`] is the one place that prints an error and turns the
+/// result into the exit code.
+pub(crate) type CmdResult = Result<Done, Failure>;
+
 impl Failure {
+    /// The failure for one of the library's exit codes (2 bad input, 3 a drop or search
+    /// failed, 4 an output could not be written).
+    pub(crate) fn coded(code: u8, error: impl std::fmt::Display) -> Self {
+        let e = anyhow::anyhow!("{error}");
+        match code {
+            2 => Failure::Input(e),
+            3 => Failure::Solve(e),
+            _ => Failure::Output(e),
+        }
+    }
+
     fn code(&self) -> u8 {
         match self {
             Failure::Input(_) => 2,
@@ -497,11 +532,11 @@ fn main() -> ExitCode {
 /// Runs the command; returns its exit code.
 fn run() -> u8 {
     let cli = Cli::parse();
-    let result = match &cli.command {
-        Command::Drop(a) => run_drop(a),
+    let result: CmdResult = match &cli.command {
+        Command::Drop(a) => run_drop(a).map(|()| Done::Clean),
         Command::Scene(a) => {
             outln!("{}", scene_text(a));
-            Ok(())
+            Ok(Done::Clean)
         }
         Command::Schema(a) => {
             let schema = match a.kind {
@@ -513,23 +548,26 @@ fn run() -> u8 {
                 "{}",
                 serde_json::to_string_pretty(&schema).expect("a schema serialises")
             );
-            Ok(())
+            Ok(Done::Clean)
         }
-        Command::Bench(a) => bench::run(a).map_err(Failure::Solve),
-        Command::Render(a) => render_cmd::run(a).map_err(|f| match f {
-            render_cmd::RenderFailure::Input(e) => Failure::Input(e),
-            render_cmd::RenderFailure::Output(e) => Failure::Output(e),
-        }),
-        Command::Critical(a) => critical_cmd::run(a),
-        Command::Sweep(a) => return sweep_cmd::run(a),
-        Command::Accuracy(a) => accuracy_cmd::run_cmd(a),
-        Command::Merge(a) => return merge_cmd::run(a),
-        Command::Compare(a) => return compare_cmd::run(a),
-        Command::Ensemble(a) => return ensemble_cmd::run_ensemble_cmd(a),
-        Command::Adaptive(a) => return ensemble_cmd::run_adaptive_cmd(a),
+        Command::Bench(a) => bench::run(a).map(|()| Done::Clean).map_err(Failure::Solve),
+        Command::Render(a) => render_cmd::run(a)
+            .map(|()| Done::Clean)
+            .map_err(|f| match f {
+                render_cmd::RenderFailure::Input(e) => Failure::Input(e),
+                render_cmd::RenderFailure::Output(e) => Failure::Output(e),
+            }),
+        Command::Critical(a) => critical_cmd::run(a).map(|()| Done::Clean),
+        Command::Sweep(a) => sweep_cmd::run(a),
+        Command::Accuracy(a) => accuracy_cmd::run_cmd(a).map(|()| Done::Clean),
+        Command::Merge(a) => merge_cmd::run(a),
+        Command::Compare(a) => compare_cmd::run(a),
+        Command::Ensemble(a) => ensemble_cmd::run_ensemble_cmd(a),
+        Command::Adaptive(a) => ensemble_cmd::run_adaptive_cmd(a),
     };
     match result {
-        Ok(()) => 0,
+        Ok(Done::Clean) => 0,
+        Ok(Done::Flagged) => 1,
         Err(f) => {
             errln!("error: {:#}", f.error());
             f.code()

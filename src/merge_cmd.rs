@@ -7,6 +7,7 @@
 //! list, a folder that is not a shard's, an output folder holding another run's results
 //! without --overwrite) with every problem listed; 4 an output could not be written.
 
+use crate::{CmdResult, Done, Failure};
 use std::path::PathBuf;
 use whirlmap_sweep::merge::merge;
 
@@ -26,16 +27,13 @@ pub struct MergeArgs {
     overwrite: bool,
 }
 
-/// Runs the subcommand and returns the process exit code.
-pub fn run(a: &MergeArgs) -> u8 {
+/// Runs the subcommand: `Flagged` (exit 1) when some points failed.
+pub fn run(a: &MergeArgs) -> CmdResult {
     let out = match &a.out {
         Some(o) => o.clone(),
         None => match whirlmap_sweep::shard::read_shard_manifest(&a.dirs[0]) {
             Ok(m) => PathBuf::from("results").join(&m.spec.name),
-            Err(e) => {
-                errln!("error: merge refused:\n  - {e}");
-                return 2;
-            }
+            Err(e) => return Err(Failure::coded(2, format!("merge refused:\n  - {e}"))),
         },
     };
     match merge(&a.dirs, &out, a.overwrite, &crate::sweep_cmd::draw_charts) {
@@ -58,15 +56,8 @@ pub fn run(a: &MergeArgs) -> u8 {
             if !o.charts.is_empty() {
                 outln!("  charts           {} files", o.charts.len());
             }
-            if o.failed > 0 {
-                1
-            } else {
-                0
-            }
+            Ok(Done::flagged_if(o.failed > 0))
         }
-        Err(e) => {
-            errln!("error: {e}");
-            e.exit_code()
-        }
+        Err(e) => Err(Failure::coded(e.exit_code(), e)),
     }
 }

@@ -3,6 +3,7 @@
 //! point failed (records still written), 2 bad input, 4 an output could not be written.
 
 use crate::sweep_cmd::SweepArgs;
+use crate::{CmdResult, Done, Failure};
 use std::path::PathBuf;
 use whirlmap_sweep::pipeline::{self, Stages};
 use whirlmap_sweep::shard::Shard;
@@ -10,14 +11,8 @@ use whirlmap_sweep::spec::SweepSpec;
 use whirlmap_sweep::sweep::{ProgressMode, RunOptions};
 
 /// Runs shard `index` of `count` of `spec` with the options of `a`.
-pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> u8 {
-    let shard = match Shard::new(index, count) {
-        Ok(s) => s,
-        Err(e) => {
-            errln!("error: {e}");
-            return 2;
-        }
-    };
+pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> CmdResult {
+    let shard = Shard::new(index, count).map_err(|e| Failure::coded(2, e))?;
     let out_dir = a.out.clone().unwrap_or_else(|| {
         PathBuf::from("results")
             .join(&spec.name)
@@ -38,13 +33,9 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> u8 {
         on_grid: &|_| {},
         draw_charts: &crate::sweep_cmd::draw_charts,
     };
-    let (outcome, critical) = match pipeline::run(spec, &opts, Some(shard), &stages) {
-        Ok(o) => (o.outcome, o.extras.critical),
-        Err(e) => {
-            errln!("error: {e}");
-            return e.exit_code();
-        }
-    };
+    let (outcome, critical) = pipeline::run(spec, &opts, Some(shard), &stages)
+        .map(|o| (o.outcome, o.extras.critical))
+        .map_err(|e| Failure::coded(e.exit_code(), e))?;
     outln!(
         "sweep {} shard {}: {} points, {} ok, {} failed{}",
         spec.name,
@@ -62,9 +53,5 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> u8 {
         outln!("  critical speeds  {}", p.display());
     }
     outln!("  output           {}", opts.out_dir.display());
-    if outcome.failed > 0 {
-        1
-    } else {
-        0
-    }
+    Ok(Done::flagged_if(outcome.failed > 0))
 }

@@ -4,6 +4,7 @@
 //! unusable output folder, or one that is in use or holds another run's results (nothing
 //! run); 4 an output (records or charts) could not be written, a full disk included.
 
+use crate::{CmdResult, Done, Failure};
 use std::path::{Path, PathBuf};
 use whirlmap_sweep::pipeline::{self, ChartsFailed, Stages};
 use whirlmap_sweep::spec;
@@ -50,15 +51,9 @@ pub struct SweepArgs {
     shards: Option<usize>,
 }
 
-/// Runs the subcommand and returns the process exit code.
-pub fn run(a: &SweepArgs) -> u8 {
-    let spec = match spec::read(&a.file) {
-        Ok(s) => s,
-        Err(e) => {
-            errln!("error: {e}");
-            return 2;
-        }
-    };
+/// Runs the subcommand: `Flagged` (exit 1) when some points failed.
+pub fn run(a: &SweepArgs) -> CmdResult {
+    let spec = spec::read(&a.file).map_err(|e| Failure::coded(2, e))?;
     if let (Some(i), Some(n)) = (a.shard, a.shards) {
         return crate::shard_cmd::run(a, &spec, i, n);
     }
@@ -99,13 +94,8 @@ pub fn run(a: &SweepArgs) -> u8 {
         on_grid: &on_grid,
         draw_charts: &draw_charts,
     };
-    let done = match pipeline::run(&spec, &opts, None, &stages) {
-        Ok(d) => d,
-        Err(e) => {
-            errln!("error: {e}");
-            return e.exit_code();
-        }
-    };
+    let done =
+        pipeline::run(&spec, &opts, None, &stages).map_err(|e| Failure::coded(e.exit_code(), e))?;
     let x = &done.extras;
     if let Some(p) = &x.critical {
         outln!("  critical speeds  {}", p.display());
@@ -119,10 +109,5 @@ pub fn run(a: &SweepArgs) -> u8 {
     if let Some(written) = &done.charts {
         outln!("  charts           {} files", written.len());
     }
-    let outcome = done.outcome;
-    if outcome.failed > 0 {
-        1
-    } else {
-        0
-    }
+    Ok(Done::flagged_if(done.outcome.failed > 0))
 }
