@@ -3,10 +3,16 @@
 //! error is not a terminal (a log file, a batch job), and nothing when switched off.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
+
+/// Writes a progress line to standard error; a closed standard error is ignored (progress is
+/// not the result, and `eprintln!` would panic).
+pub fn progress_line(line: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
+}
 
 /// How often a plain progress line is written.
 const PLAIN_EVERY: Duration = Duration::from_secs(5);
@@ -76,7 +82,7 @@ impl Ticker {
             let mut last = self.last_line.lock().unwrap_or_else(|e| e.into_inner());
             if last.elapsed() >= PLAIN_EVERY {
                 *last = Instant::now();
-                crate::sweep::progress_line(&self.line());
+                progress_line(&self.line());
             }
         }
     }
@@ -103,7 +109,7 @@ impl Ticker {
             b.finish_and_clear();
         }
         if self.plain && self.start.elapsed() >= PLAIN_EVERY {
-            crate::sweep::progress_line(&self.line());
+            progress_line(&self.line());
         }
     }
 }

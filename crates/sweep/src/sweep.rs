@@ -222,11 +222,7 @@ struct Progress {
 
 const PLAIN_EVERY: Duration = Duration::from_secs(5);
 
-/// Writes a progress line to standard error; a closed standard error is ignored (progress is
-/// not the result, and `eprintln!` would panic).
-pub fn progress_line(line: &str) {
-    let _ = writeln!(std::io::stderr().lock(), "{line}");
-}
+pub use crate::progress::progress_line;
 
 impl Progress {
     fn new(name: &str, total: usize, already: usize, mode: ProgressMode) -> Self {
