@@ -202,11 +202,10 @@ impl TemperatureFigure<'_> {
             .margin_top(8)
             .margin_bottom(6)
             .margin_left(20)
-            .margin_right(8)
+            // Aligned with the temperature panel, whose right label area (deg C) is 78 px.
+            .margin_right(8 + 78)
             .x_label_area_size(48)
             .y_label_area_size(78)
-            // Aligned with the temperature panel's right (deg C) axis.
-            .right_y_label_area_size(78)
             .build_cartesian_2d(t0..t1, lo.min(0.0)..hi.max(1.0))?;
         draw_mesh(&mut chart, "time (s)", y_desc, 10, 4)?;
         let pts: Vec<(f64, f64)> = self
