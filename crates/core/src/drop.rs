@@ -1,6 +1,7 @@
 //! One drop, end to end: release, integrate through every located mode switch, stop at the
 //! duration or when the whirl stopping rule decides, and audit the energy.
 
+use crate::bearing::{BearingAnalysis, BearingReport};
 use crate::classify::{classify, Verdict};
 use crate::error::{InvalidParameter, SolveError};
 use crate::model::{ix, DropSystem, Mode, N};
@@ -244,6 +245,9 @@ pub struct DropReport {
     pub final_state: [f64; N],
     /// Temperatures, thermal load and heat, when the scene carries a thermal model.
     pub thermal: Option<ThermalReport>,
+    /// Ball loads, contact pressure and fatigue of the touchdown bearing, when the scene
+    /// asks for the bearing analysis ([`crate::bearing`]).
+    pub bearing: Option<BearingReport>,
     /// The orbit class, whether it settled, and why ([`crate::classify`]).
     pub verdict: Verdict,
     /// How far the run was extended past its duration to let the class settle (s); 0 when
@@ -273,6 +277,9 @@ struct Tap<'a, O> {
     stop_speed_rad_s: f64,
     /// The macro-step coupling, when the scene has a thermal model.
     thermal: Option<ThermalRun>,
+    /// The touchdown bearing analysis, when the scene asks for it: it reads the race's
+    /// displacement, spin and support force at every step's end.
+    bearing: Option<BearingAnalysis>,
     /// Mechanical energy lost at mode switches (J): the elastic energy of a contact opened
     /// while still overlapping, booked with the damping loss.
     switch_loss_j: f64,
@@ -282,6 +289,11 @@ impl<O: Observer<DropSystem, N>> Observer<DropSystem, N> for Tap<'_, O> {
     type Halt = Halt;
     fn on_step(&mut self, sys: &DropSystem, step: &StepView<'_, N>) -> ControlFlow<Halt> {
         let _ = self.extra.on_step(sys, step);
+        if let Some(b) = self.bearing.as_mut() {
+            let (t1, y1) = (step.dense.t1(), step.dense.y1());
+            let support_n = sys.with_forces(&y1, |f| f.support_n);
+            b.observe_with_force(t1, y1[ix::XB], y1[ix::YB], y1[ix::WB], support_n);
+        }
         if let ControlFlow::Break(WhirlDecided) = self.mon.on_step(sys, step) {
             return ControlFlow::Break(Halt::WhirlDecided);
         }
@@ -431,11 +443,22 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
         Some(p) => Some(ThermalRun::new(scene, p, opts.duration_s, &y)?),
         None => None,
     };
+    let bearing = match &scene.bearing {
+        Some(pair) => {
+            let mut pair = pair.clone();
+            if scene.support_exponent == 1.5 {
+                pair.lumped_stiffness_n_per_m1_5 = scene.support_stiffness_n_per_m_e;
+            }
+            Some(BearingAnalysis::new(&pair)?)
+        }
+        None => None,
+    };
     let mut tap = Tap {
         extra,
         mon,
         stop_speed_rad_s: scene.stop_speed_rpm.unwrap_or(0.0) * std::f64::consts::PI / 30.0,
         thermal,
+        bearing,
         switch_loss_j: 0.0,
     };
     let rules = jump_rules(scene);
@@ -472,6 +495,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
     let Tap {
         mon,
         thermal,
+        bearing,
         switch_loss_j: switch_loss,
         ..
     } = tap;
@@ -494,6 +518,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
     let (features, orbit) = mon.finish(&sys, t, &y);
     let verdict = classify(&features, stop_reason, cls);
     let thermal = thermal.map(|th| th.finish(t, &y));
+    let bearing = bearing.map(BearingAnalysis::finish);
     Ok(DropReport {
         inputs: DropInputs::new(scene, opts.duration_s),
         features,
@@ -505,6 +530,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
         scene_hash: scene.hash_hex(),
         final_state: y,
         thermal,
+        bearing,
         verdict,
         extension_s: (t - opts.duration_s).max(0.0),
     })

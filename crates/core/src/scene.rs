@@ -5,6 +5,7 @@
 //! docs/model.md#default-scene (`Scene::paper()`); catalogue units (N/mm^1.5, cSt, N mm) are
 //! converted here and in [`crate::model::drag`], nowhere else.
 
+use crate::bearing::BearingPair;
 use crate::classify::ClassifyParams;
 use crate::error::InvalidParameter;
 use crate::thermal::ThermalParams;
@@ -273,6 +274,13 @@ pub struct Scene {
     /// [`ThermalParams`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thermal: Option<ThermalParams>,
+    /// The touchdown bearing analysis (ball loads, contact pressure against the static
+    /// limit, fatigue damage per drop; [`crate::bearing`]): `null` (default, left out of the
+    /// JSON) for none. It reads the race's motion as the drop runs and does not change the
+    /// dynamics. `{}` takes the paper's pair (two 71908 CD face to face); its lumped
+    /// stiffness is the scene's `support_stiffness_n_per_m_e` when `support_exponent` is 1.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bearing: Option<BearingPair>,
 }
 
 impl Default for Scene {
@@ -349,6 +357,7 @@ impl Scene {
         "quasi_static_race",
         "stop_speed_rpm",
         "thermal",
+        "bearing",
     ];
 
     /// The paper's scene: Tables 2-4 with the defaults of docs/model.md#default-scene,
@@ -391,6 +400,7 @@ impl Scene {
             quasi_static_race: false,
             stop_speed_rpm: None,
             thermal: None,
+            bearing: None,
         }
     }
 
@@ -419,6 +429,9 @@ impl Scene {
         self.validate_consistency()?;
         if let Some(t) = &self.thermal {
             t.validate_with(self.race_bore_radius_m(), self.pitch_diameter_m)?;
+        }
+        if let Some(b) = &self.bearing {
+            b.validate()?;
         }
         Ok(())
     }

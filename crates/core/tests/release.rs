@@ -30,6 +30,7 @@ fn optional_fields_are_exactly_those_the_json_omits_at_their_default() {
     t.quasi_static_race = true;
     t.stop_speed_rpm = Some(100.0);
     t.thermal = Some(Default::default());
+    t.bearing = Some(Default::default());
     t.solver.method = whirlmap_core::Method::Ros34pw2;
     t.solver.free_flight_gap_bound = true;
     t.solver.race_atol_scale = 10.0;

@@ -62,6 +62,27 @@ pub struct DropRecord {
     /// Heat made (H_s, H_i, H_o integrated, J) and where it went; only with the thermal model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub heat: Option<HeatEnergies>,
+    /// Peak load on one ball of the touchdown bearing pair (N); only with the bearing
+    /// analysis (absent otherwise, so records without it are unchanged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_ball_load_n: Option<f64>,
+    /// Peak Hertz contact pressure of the most loaded ball, inner or outer race (Pa); only
+    /// with the bearing analysis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_contact_pressure_pa: Option<f64>,
+    /// The static limit (4.2 GPa, ISO 76) over the peak contact pressure; below 1 the drop
+    /// brinells the races. Only with the bearing analysis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub static_safety_factor: Option<f64>,
+    /// Palmgren-Miner fatigue damage of the inner race from this drop (ISO 281 load-life,
+    /// L10 sense); only with the bearing analysis. A whirl run stopped after
+    /// `whirl_stop_turns` turns gives the damage of those turns only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damage_per_drop: Option<f64>,
+    /// Drops of this kind to fatigue failure (1 / damage, L10 sense); only with the bearing
+    /// analysis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drops_to_failure: Option<f64>,
 }
 
 impl DropRecord {
@@ -91,6 +112,11 @@ impl DropRecord {
             temperatures_k: r.thermal.as_ref().map(|t| t.temperatures_k),
             thermal_load_n: r.thermal.as_ref().map(|t| t.peak_thermal_load_n),
             heat: r.thermal.as_ref().map(|t| t.heat),
+            peak_ball_load_n: r.bearing.as_ref().map(|b| b.peak_ball_load_n),
+            peak_contact_pressure_pa: r.bearing.as_ref().map(|b| b.peak_contact_pressure_pa),
+            static_safety_factor: r.bearing.as_ref().map(|b| b.static_safety_factor),
+            damage_per_drop: r.bearing.as_ref().map(|b| b.damage_per_drop),
+            drops_to_failure: r.bearing.as_ref().map(|b| b.drops_to_failure),
         }
     }
 }

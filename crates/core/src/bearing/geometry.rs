@@ -74,6 +74,7 @@ pub fn iso281_fc(gamma: f64) -> Option<f64> {
 
 /// The touchdown bearing pair: geometry, material, ratings and the lumped stiffness the
 /// dynamics use. SI units; every field is documented with its default and source.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BearingPair {
