@@ -273,7 +273,8 @@ pub fn scene_schema() -> serde_json::Value {
                 Some(Value::Array(ts)) => ts.iter().any(numeric),
                 _ => false,
             };
-            if let Some(range) = FIELD_RANGES.iter().find(|r| r.key == key) {
+            let range = FIELD_RANGES.iter().find(|r| r.key == key);
+            if let Some(range) = range {
                 match range.min {
                     Some(Bound::Inclusive(v)) => {
                         p.insert("minimum".into(), v.into());
@@ -293,7 +294,7 @@ pub fn scene_schema() -> serde_json::Value {
                     None => {}
                 }
             }
-            if is_number || FIELD_RANGES.iter().any(|r| r.key == key) {
+            if is_number || range.is_some() {
                 p.insert("x-unit".into(), unit_of(&key).into());
             }
             p.insert("x-source".into(), source_of(&description).into());

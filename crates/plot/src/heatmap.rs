@@ -227,41 +227,31 @@ impl Figure for GridFigure<'_> {
             // A level just inside the range of the values cuts one corner of one cell: a
             // stray dot, not a line. A level whose contour is shorter than 30 pixels in all
             // is left out (here and on the colour bar).
-            levels.retain(|&level| {
-                let total: f64 = marching_squares(&g.speeds_rpm, &g.mus, &z, level)
-                    .iter()
-                    .map(|s| {
-                        let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
-                        (((p.0 - q.0).pow(2) + (p.1 - q.1).pow(2)) as f64).sqrt()
-                    })
-                    .sum();
-                total >= 30.0
-            });
-            for &level in &levels {
-                let segs = marching_squares(&g.speeds_rpm, &g.mus, &z, level);
-                for s in &segs {
+            let seg_px = |s: &[(f64, f64); 2]| {
+                let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
+                (((p.0 - q.0).pow(2) + (p.1 - q.1).pow(2)) as f64).sqrt()
+            };
+            let contours: Vec<_> = levels
+                .iter()
+                .map(|&level| (level, marching_squares(&g.speeds_rpm, &g.mus, &z, level)))
+                .filter(|(_, segs)| segs.iter().map(seg_px).sum::<f64>() >= 30.0)
+                .collect();
+            levels = contours.iter().map(|(level, _)| *level).collect();
+            for (level, segs) in &contours {
+                for s in segs {
                     canvas.draw(&PathElement::new(
                         vec![px(s[0].0, s[0].1), px(s[1].0, s[1].1)],
                         CONTOUR.mix(0.8).stroke_width(2),
                     ))?;
                 }
-                // Label the level once, on its longest segment.
-                let longest = segs.iter().max_by(|a, b| {
-                    let len = |s: &[(f64, f64); 2]| {
-                        let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
-                        (((p.0 - q.0).pow(2) + (p.1 - q.1).pow(2)) as f64).sqrt()
-                    };
-                    len(a).total_cmp(&len(b))
-                });
-                let long_enough = |s: &&[(f64, f64); 2]| {
-                    let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
-                    (p.0 - q.0).pow(2) + (p.1 - q.1).pow(2) >= 24 * 24
-                };
+                // Label the level once, on its longest segment, if that is 24 px or more.
+                let longest = segs.iter().max_by(|a, b| seg_px(a).total_cmp(&seg_px(b)));
+                let long_enough = |s: &&[(f64, f64); 2]| seg_px(s) >= 24.0;
                 if let Some(s) = longest.filter(long_enough) {
                     let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
                     boxed_text(
                         &canvas,
-                        &format_quantity(level),
+                        &format_quantity(*level),
                         ((p.0 + q.0) / 2, (p.1 + q.1) / 2),
                         13.0,
                         CONTOUR,

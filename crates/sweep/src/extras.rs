@@ -90,10 +90,11 @@ pub fn run_all_owned(
     progress: bool,
     owns: impl Fn(usize) -> bool + Sync,
 ) -> Result<ExtrasWritten, ExtrasError> {
+    let panels = orbit_panels(spec).map_or(0, |(_, mus)| mus.len());
     let ticker = Ticker::new(
         &format!("sweep {}: critical search and orbits", spec.name),
-        orbit_panels(spec).map_or(0, |(_, mus)| mus.len()),
-        progress && (spec.critical.is_some() || orbit_panels(spec).is_some()),
+        panels,
+        progress && (spec.critical.is_some() || panels > 0),
     );
     let work = || -> Result<_, ExtrasError> {
         let ((critical, orbits), probability) = rayon::join(
