@@ -23,6 +23,8 @@ pub fn draw_marked_class_map(
         title: with_slice(title, &grid.slice),
         mode: GridMode::MarkedClasses(marked),
         bar_label: "",
+        whirl_label: None,
+        limit: None,
     };
     render(path, CHART_SIZE, &figure)?;
     Ok(())
@@ -35,5 +37,7 @@ pub(crate) fn figure(grid: &Grid) -> GridFigure<'_> {
         title: with_slice("Orbit class over release speed and friction", &grid.slice),
         mode: GridMode::Classes,
         bar_label: "",
+        whirl_label: None,
+        limit: None,
     }
 }

@@ -4,10 +4,11 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 
-use crate::marks::CONTOUR;
+use crate::marks::{CONTOUR, LIMIT};
 use crate::render::{
     text_style, tick_formatter, DrawResult, AXIS_DESC_FONT, TICK_FONT, X_LABEL_AREA,
 };
+use plotters::element::DashedPathElement;
 
 /// The colour-scale colour of `v` in `lo..hi` (ends for anything outside, mid for NaN).
 pub(crate) fn scale_colour(v: f64, lo: f64, hi: f64) -> RGBColor {
@@ -20,13 +21,29 @@ pub(crate) fn scale_colour(v: f64, lo: f64, hi: f64) -> RGBColor {
     ViridisRGB::get_color_normalized(t, 0.0, 1.0)
 }
 
+/// What a colour bar shows.
+pub(crate) struct ColourBar<'a> {
+    /// The scale's low end (a decade exponent on a log scale).
+    pub(crate) lo: f64,
+    /// The scale's high end.
+    pub(crate) hi: f64,
+    /// The contour levels, drawn across the bar.
+    pub(crate) levels: &'a [f64],
+    /// A limit, drawn across the bar dashed in the limit colour.
+    pub(crate) limit: Option<f64>,
+    /// The bar's axis title.
+    pub(crate) label: &'a str,
+    /// A tick's text on a log scale (a linear scale uses the shared tick formatter).
+    pub(crate) tick: &'a dyn Fn(&f64) -> String,
+    /// Whether the scale is logarithmic (ticks then fall on whole decades).
+    pub(crate) log: bool,
+}
+
 pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    lo: f64,
-    hi: f64,
-    levels: &[f64],
-    label: &str,
+    b: &ColourBar,
 ) -> DrawResult<DB> {
+    let (lo, hi) = (b.lo, b.hi);
     let mut bar = ChartBuilder::on(area)
         .margin_top(12)
         .margin_bottom(4 + X_LABEL_AREA)
@@ -34,15 +51,22 @@ pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
         .margin_right(4)
         .right_y_label_area_size(96)
         .build_cartesian_2d(0.0..1.0, lo..hi)?;
-    let fmt = tick_formatter(hi - lo);
+    let linear = tick_formatter(hi - lo);
+    let fmt: &dyn Fn(&f64) -> String = if b.log { b.tick } else { &linear };
+    // On a log scale one tick per decade (plotters picks round values of the exponent).
+    let ticks = if b.log {
+        ((hi - lo).ceil() as usize + 1).clamp(2, 10)
+    } else {
+        8
+    };
     bar.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
-        .y_labels(8)
+        .y_labels(ticks)
         // Ticks outside the bar, so a label never touches a contour level's line.
         .set_tick_mark_size(LabelAreaPosition::Right, 6)
-        .y_label_formatter(&fmt)
-        .y_desc(label)
+        .y_label_formatter(fmt)
+        .y_desc(b.label)
         .label_style(text_style(TICK_FONT))
         .axis_desc_style(text_style(AXIS_DESC_FONT))
         .axis_style(RGBColor(90, 90, 90).stroke_width(1))
@@ -55,10 +79,18 @@ pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
         Rectangle::new([(0.0, a), (1.0, b)], c.filled())
     }))?;
     bar.draw_series(
-        levels
+        b.levels
             .iter()
             .map(|&l| PathElement::new(vec![(0.0, l), (1.0, l)], CONTOUR.stroke_width(2))),
     )?;
+    if let Some(l) = b.limit {
+        bar.draw_series([DashedPathElement::new(
+            vec![(0.0, l), (1.0, l)],
+            6,
+            4,
+            LIMIT.stroke_width(3),
+        )])?;
+    }
     bar.draw_series([Rectangle::new(
         [(0.0, lo), (1.0, hi)],
         RGBColor(90, 90, 90).stroke_width(1),

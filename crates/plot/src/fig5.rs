@@ -3,14 +3,16 @@
 
 use whirlmap_results::grid::Grid;
 
-use crate::heatmap::{with_slice, GridFigure, GridMode};
+use crate::heatmap::{with_slice, GridFigure, GridMode, Metric};
 
 /// The figure of `grid` (`charts/fig5_max_force`).
 pub(crate) fn figure(grid: &Grid) -> GridFigure<'_> {
     GridFigure {
         grid,
         title: with_slice("Fig. 5: maximum contact force", &grid.slice),
-        mode: GridMode::Metric(|r| r.max_contact_force_n),
+        mode: GridMode::Metric(Metric::linear(|r| r.max_contact_force_n)),
         bar_label: "max contact force (N)",
+        whirl_label: None,
+        limit: None,
     }
 }

@@ -8,15 +8,17 @@ use whirlmap_results::grid::{clamp_value, Grid};
 use whirlmap_results::point::PointRow;
 
 use crate::axes::{MU_DESC, SPEED_DESC};
-use crate::colour_bar::{draw_colour_bar, scale_colour};
+use crate::colour_bar::{draw_colour_bar, scale_colour, ColourBar};
 use crate::contour::{marching_squares, nice_levels};
 use crate::marks::{
-    boxed_text, class_colour, cross, hatch, legend, Mark, ALL_CLASSES, CONTOUR, FAILED_BG, WHIRL_BG,
+    boxed_text, class_colour, cross, hatch, hatch_in, legend, Mark, ALL_CLASSES, CONTOUR,
+    FAILED_BG, LIMIT, WHIRL_BG, WHIRL_OVER,
 };
 use crate::render::{
     draw_mesh, format_quantity, with_header, DrawResult, Figure, CAPTION_FONT, TITLE_BAND,
     TITLE_FONT, X_LABEL_AREA, Y_LABEL_AREA,
 };
+use plotters::element::DashedPathElement;
 use whirlmap_results::point::PointStatus;
 
 /// Cell edges around increasing centres: midpoints, extended by half a step at the ends.
@@ -56,15 +58,74 @@ pub(crate) enum CellKind {
     /// settled motion, so they stay out of the scale.
     Unresolved,
     Value(f64),
+    /// A whirl cell whose value stays in the scale ([`Metric::whirl_in_scale`]).
+    WhirlValue(f64, OrbitClass),
     Class(OrbitClass),
     NoValue,
+}
+
+/// A quantity drawn in a colour scale.
+#[derive(Clone, Copy)]
+pub(crate) struct Metric {
+    /// The cell's value, in the colour bar's unit.
+    pub(crate) value: fn(&PointRow) -> Option<f64>,
+    /// Whirl cells keep their value in the scale, hatched over their colour, instead of
+    /// being left out.
+    pub(crate) whirl_in_scale: bool,
+    /// A logarithmic colour scale, with the decades as contour levels (values must be
+    /// positive; others are left out).
+    pub(crate) log: bool,
+}
+
+/// A limit drawn on a heat map as its own dashed contour where the values cross it; the
+/// legend names it and says when no cell reaches it.
+pub(crate) struct Limit {
+    /// The limit in the colour bar's unit.
+    pub(crate) value: f64,
+    /// Its legend name ("static limit 4.2 GPa (ISO 76)").
+    pub(crate) name: String,
+    /// The bar's unit, for the legend's "highest" value.
+    pub(crate) unit: &'static str,
+}
+
+impl Metric {
+    /// A linear scale, whirl cells left out (Figs. 5 and 6).
+    pub(crate) const fn linear(value: fn(&PointRow) -> Option<f64>) -> Self {
+        Self {
+            value,
+            whirl_in_scale: false,
+            log: false,
+        }
+    }
+
+    /// The value of `row` on the scale's axis (its decade exponent on a log scale).
+    fn scaled(&self, row: &PointRow) -> Option<f64> {
+        let v = (self.value)(row)?;
+        match self.log {
+            true if v > 0.0 => Some(v.log10()),
+            true => None,
+            false => Some(v),
+        }
+    }
+
+    /// A value on the scale's axis as text in the bar's unit.
+    fn label(&self, x: f64) -> String {
+        if !self.log {
+            return format_quantity(x);
+        }
+        if (x - x.round()).abs() < 1e-9 {
+            return format!("1e{}", x.round() as i64);
+        }
+        let s = format!("{:.1e}", 10f64.powf(x));
+        s.replace(".0e", "e")
+    }
 }
 
 /// What the grid charts draw per cell.
 #[derive(Clone, Copy)]
 pub(crate) enum GridMode<'a> {
-    /// A metric in a colour scale, whirl left out.
-    Metric(fn(&PointRow) -> Option<f64>),
+    /// A quantity in a colour scale.
+    Metric(Metric),
     /// The class colour.
     Classes,
     /// The class colour, the cells `(speed index, friction index)` outlined (`compare`).
@@ -76,6 +137,11 @@ pub(crate) struct GridFigure<'a> {
     pub(crate) title: String,
     pub(crate) mode: GridMode<'a>,
     pub(crate) bar_label: &'static str,
+    /// The legend's words for whirl cells kept in the scale (what their value means), when
+    /// the default ("backward whirl (in scale)") says too little.
+    pub(crate) whirl_label: Option<String>,
+    /// A limit to draw (metric modes only).
+    pub(crate) limit: Option<Limit>,
 }
 
 impl GridFigure<'_> {
@@ -91,11 +157,13 @@ impl GridFigure<'_> {
         };
         match self.mode {
             GridMode::Classes | GridMode::MarkedClasses(_) => CellKind::Class(class),
-            GridMode::Metric(_) if class.is_whirl() => CellKind::Whirl(class),
+            GridMode::Metric(m) if class.is_whirl() && !m.whirl_in_scale => CellKind::Whirl(class),
             GridMode::Metric(_) if class == OrbitClass::Unresolved => CellKind::Unresolved,
-            GridMode::Metric(f) => {
-                f(row).map_or(CellKind::NoValue, |v| CellKind::Value(clamp_value(v)))
-            }
+            GridMode::Metric(m) => match m.scaled(row).map(clamp_value) {
+                Some(v) if class.is_whirl() => CellKind::WhirlValue(v, class),
+                Some(v) => CellKind::Value(v),
+                None => CellKind::NoValue,
+            },
         }
     }
 }
@@ -111,16 +179,26 @@ impl Figure for GridFigure<'_> {
         let values: Vec<f64> = kinds
             .iter()
             .filter_map(|k| match k {
-                CellKind::Value(v) => Some(*v),
+                CellKind::Value(v) | CellKind::WhirlValue(v, _) => Some(*v),
                 _ => None,
             })
             .collect();
+        let metric = match self.mode {
+            GridMode::Metric(m) => Some(m),
+            _ => None,
+        };
+        // The limit on the scale's axis.
+        let limit = metric.zip(self.limit.as_ref()).and_then(|(m, lim)| {
+            let l = if m.log { lim.value.log10() } else { lim.value };
+            l.is_finite().then_some((l, lim.name.as_str(), lim.unit))
+        });
         let scale = values
             .iter()
             .fold(None, |acc: Option<(f64, f64)>, &v| match acc {
                 None => Some((v, v)),
                 Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
             });
+        let data_range = scale;
         let scale = scale.map(|(lo, hi)| {
             if hi > lo {
                 (lo, hi)
@@ -133,7 +211,12 @@ impl Figure for GridFigure<'_> {
 
         let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (bw, bh) = body.dim_in_pixel();
-        let (main, legend_band) = body.split_vertically(bh.saturating_sub(44));
+        let legend_h = if self.whirl_label.is_some() || limit.is_some() {
+            66
+        } else {
+            44
+        };
+        let (main, legend_band) = body.split_vertically(bh.saturating_sub(legend_h));
         let (plot_area, bar_area) = if is_metric {
             main.split_horizontally(bw.saturating_sub(150))
         } else {
@@ -159,6 +242,7 @@ impl Figure for GridFigure<'_> {
         let canvas = pa.strip_coord_spec();
         let (mut any_failed, mut any_empty, mut any_unresolved) = (false, false, false);
         let mut whirl_seen = [false, false];
+        let mut whirl_in_scale_seen = false;
         for j in 0..ny {
             for i in 0..nx {
                 let tl = px(xe[i], ye[j + 1]);
@@ -170,6 +254,12 @@ impl Figure for GridFigure<'_> {
                         let (lo, hi) = scale.unwrap_or((0.0, 1.0));
                         let c = scale_colour(v, lo, hi);
                         canvas.draw(&Rectangle::new([tl, br], c.filled()))?;
+                    }
+                    CellKind::WhirlValue(v, c) => {
+                        whirl_in_scale_seen = true;
+                        let (lo, hi) = scale.unwrap_or((0.0, 1.0));
+                        canvas.draw(&Rectangle::new([tl, br], scale_colour(v, lo, hi).filled()))?;
+                        hatch_in(&canvas, tl, br, c == OrbitClass::ForwardWhirl, WHIRL_OVER)?;
                     }
                     CellKind::Class(c) => {
                         canvas.draw(&Rectangle::new([tl, br], class_colour(c).filled()))?;
@@ -213,14 +303,22 @@ impl Figure for GridFigure<'_> {
         }
 
         let mut levels = Vec::new();
+        let mut limit_entry = None;
         if let (GridMode::Metric(_), Some((lo, hi))) = (self.mode, scale) {
+            let m = metric.expect("a metric mode");
             if values.len() >= 2 {
-                levels = nice_levels(lo, hi, 6);
+                levels = match m.log {
+                    // Whole decades, when the scale spans two or more.
+                    true if hi.floor() - lo.ceil() >= 1.0 => (lo.ceil() as i64..=hi.floor() as i64)
+                        .map(|d| d as f64)
+                        .collect(),
+                    _ => nice_levels(lo, hi, 6),
+                };
             }
             let z: Vec<f64> = kinds
                 .iter()
                 .map(|k| match k {
-                    CellKind::Value(v) => *v,
+                    CellKind::Value(v) | CellKind::WhirlValue(v, _) => *v,
                     _ => f64::NAN,
                 })
                 .collect();
@@ -251,12 +349,31 @@ impl Figure for GridFigure<'_> {
                     let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
                     boxed_text(
                         &canvas,
-                        &format_quantity(*level),
+                        &m.label(*level),
                         ((p.0 + q.0) / 2, (p.1 + q.1) / 2),
                         13.0,
                         CONTOUR,
                     )?;
                 }
+            }
+            if let Some((l, name, unit)) = limit {
+                let segs = marching_squares(&g.speeds_rpm, &g.mus, &z, l);
+                for s in &segs {
+                    canvas.draw(&DashedPathElement::new(
+                        vec![px(s[0].0, s[0].1), px(s[1].0, s[1].1)],
+                        8,
+                        5,
+                        LIMIT.stroke_width(3),
+                    ))?;
+                }
+                limit_entry = Some(match data_range {
+                    _ if !segs.is_empty() => name.to_string(),
+                    Some((_, top)) if top < l => {
+                        format!("{name}: not reached (highest {} {unit})", m.label(top))
+                    }
+                    Some((bottom, _)) if bottom > l => format!("{name}: exceeded in every cell"),
+                    _ => name.to_string(),
+                });
             }
             if values.is_empty() {
                 let (w, h) = canvas.dim_in_pixel();
@@ -283,15 +400,35 @@ impl Figure for GridFigure<'_> {
                 }
                 entries.push((Mark::Failed, "failed".to_string()));
             }
-            GridMode::Metric(_) => {
+            GridMode::Metric(m) => {
                 if !levels.is_empty() {
-                    entries.push((Mark::Line(CONTOUR), "contour lines".to_string()));
+                    let words = if m.log {
+                        "contour lines (decades)"
+                    } else {
+                        "contour lines"
+                    };
+                    entries.push((Mark::Line(CONTOUR), words.to_string()));
                 }
-                // The backward-whirl entry is always shown: it is where the scale stops.
-                entries.push((
-                    Mark::Hatch(false),
-                    "backward whirl (not in scale)".to_string(),
-                ));
+                if let Some(text) = limit_entry.take() {
+                    entries.push((Mark::Dashed(LIMIT), text));
+                }
+                if m.whirl_in_scale {
+                    if whirl_in_scale_seen {
+                        let (lo, hi) = scale.unwrap_or((0.0, 1.0));
+                        let mid = scale_colour((lo + hi) / 2.0, lo, hi);
+                        let label = self
+                            .whirl_label
+                            .clone()
+                            .unwrap_or_else(|| "whirl (in scale)".to_string());
+                        entries.push((Mark::HatchOver(mid), label));
+                    }
+                } else {
+                    // The backward-whirl entry is always shown: it is where the scale stops.
+                    entries.push((
+                        Mark::Hatch(false),
+                        "backward whirl (not in scale)".to_string(),
+                    ));
+                }
                 if whirl_seen[1] {
                     entries.push((
                         Mark::Hatch(true),
@@ -314,8 +451,17 @@ impl Figure for GridFigure<'_> {
         }
         legend(&legend_band, &entries)?;
 
-        if let (GridMode::Metric(_), Some((lo, hi))) = (self.mode, scale) {
-            draw_colour_bar(&bar_area, lo, hi, &levels, self.bar_label)?;
+        if let (Some(m), Some((lo, hi))) = (metric, scale) {
+            let bar = ColourBar {
+                lo,
+                hi,
+                levels: &levels,
+                limit: limit.map(|(l, _, _)| l).filter(|l| (lo..=hi).contains(l)),
+                label: self.bar_label,
+                tick: &|x: &f64| m.label(*x),
+                log: m.log,
+            };
+            draw_colour_bar(&bar_area, &bar)?;
         }
         Ok(())
     }

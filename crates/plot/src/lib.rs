@@ -6,9 +6,11 @@
 //! engine that runs drops.
 //!
 //! - [`render_all()`]: every chart of a results folder into its `charts/` (Figs. 3 to 6, the
-//!   class map, the peak temperature, Fig. 4 with probability bands).
+//!   class map, the peak temperature, the bearing's drops to failure and contact pressure,
+//!   Fig. 4 with probability bands).
 //! - One chart per file: [`fig3_orbits`], [`fig4`] (critical speeds), [`fig5`] (maximum
-//!   contact force), [`fig6`] (peak heat power), [`peak_temperature`], [`classes`] (the class
+//!   contact force), [`fig6`] (peak heat power), [`peak_temperature`], [`bearing_life`]
+//!   (drops to failure, contact pressure against the static limit), [`classes`] (the class
 //!   map, also with a comparison's marked cells), [`probability`] (Fig. 4 with probability
 //!   bands), [`accuracy`] (work precision), [`thermal`] (one drop's temperatures), [`orbit`]
 //!   (one drop's orbit).
@@ -22,6 +24,7 @@
 
 pub mod accuracy;
 pub mod axes;
+pub mod bearing_life;
 pub mod classes;
 pub mod colour_bar;
 pub mod contour;

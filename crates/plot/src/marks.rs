@@ -16,6 +16,14 @@ pub(crate) const FAILED_BG: RGBColor = RGBColor(252, 226, 226);
 pub(crate) const FAILED_MARK: RGBColor = RGBColor(170, 20, 20);
 pub(crate) const CONTOUR: RGBColor = RGBColor(25, 25, 25);
 pub(crate) const BAND: RGBColor = RGBColor(214, 39, 40);
+/// A limit drawn on a heat map (the static limit of the contact pressure).
+pub(crate) const LIMIT: RGBColor = RGBColor(214, 39, 40);
+/// The hatching over a whirl cell kept in a colour scale.
+pub(crate) const WHIRL_OVER: ShapeStyle = ShapeStyle {
+    color: RGBAColor(255, 255, 255, 0.6),
+    filled: false,
+    stroke_width: 1,
+};
 
 /// The colour of each class on the class map and Fig. 4.
 pub fn class_colour(c: OrbitClass) -> RGBColor {
@@ -43,6 +51,8 @@ pub enum Mark {
     Swatch(RGBColor),
     /// A hatched box (the other diagonal when true).
     Hatch(bool),
+    /// A box of a colour with white hatching over it: a whirl cell kept in the colour scale.
+    HatchOver(RGBColor),
     /// A failed-point cross.
     Failed,
     /// A solid line.
@@ -70,8 +80,18 @@ pub(crate) fn hatch<DB: DrawingBackend>(
     (x1, y1): (i32, i32),
     forward: bool,
 ) -> DrawResult<DB> {
+    hatch_in(area, (x0, y0), (x1, y1), forward, HATCH.stroke_width(1))
+}
+
+/// Draws hatch lines as [`hatch`] does, in `style`.
+pub(crate) fn hatch_in<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x0, y0): (i32, i32),
+    (x1, y1): (i32, i32),
+    forward: bool,
+    style: ShapeStyle,
+) -> DrawResult<DB> {
     const STEP: i32 = 9;
-    let style = HATCH.stroke_width(1);
     let (w, h) = (x1 - x0, y1 - y0);
     let mut c = -h;
     while c <= w {
@@ -202,6 +222,11 @@ pub(crate) fn draw_mark<DB: DrawingBackend>(
         Mark::Hatch(forward) => {
             area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], WHIRL_BG.filled()))?;
             hatch(area, (bx0, by0), (bx1, by1), forward)?;
+            area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], border))?;
+        }
+        Mark::HatchOver(c) => {
+            area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], c.filled()))?;
+            hatch_in(area, (bx0, by0), (bx1, by1), false, WHIRL_OVER)?;
             area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], border))?;
         }
         Mark::Failed => {

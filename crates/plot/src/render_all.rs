@@ -30,7 +30,7 @@ pub(crate) fn write_both<F: Figure>(
 
 /// The charts a sweep's spec asks for (its `charts` list, as its manifest records it), by the
 /// spec's names (`orbits`, `critical`, `max_force`, `peak_power`, `classes`,
-/// `peak_temperature`); `None` when the folder has no manifest or the spec lists none: then
+/// `peak_temperature`, `drops_to_failure`, `contact_pressure`); `None` when the folder has no manifest or the spec lists none: then
 /// every chart the data allows is drawn.
 fn wanted_charts(dir: &Path) -> Option<Vec<String>> {
     #[derive(serde::Deserialize)]
@@ -49,7 +49,8 @@ fn wanted_charts(dir: &Path) -> Option<Vec<String>> {
 
 /// Draws every chart whose data exists in the results directory `dir` into `dir/charts/`, as
 /// PNG and SVG: `fig5_max_force`, `fig6_peak_power` and `classes` from `points.jsonl`
-/// (required), `peak_temperature` if the records carry temperatures, `fig4_critical` if
+/// (required), `peak_temperature` if the records carry temperatures, `drops_to_failure` and
+/// `contact_pressure` if they carry the bearing analysis's results, `fig4_critical` if
 /// `critical.json` exists, `fig3_orbits` if `orbits/` holds orbit files, `fig4_probability` if
 /// `contours.json` (an ensemble's) exists (then `points.jsonl` is optional). A sweep whose
 /// spec lists its `charts` gets only those. Returns the paths written.
@@ -94,6 +95,15 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
             &temps,
             &mut written,
         )?;
+    }
+    // Only records made with the bearing analysis carry its results.
+    if wants("drops_to_failure") && rows.iter().any(|r| r.drops_to_failure.is_some()) {
+        let fig = crate::bearing_life::drops_to_failure(&grid);
+        write_both(&out_dir, "drops_to_failure", CHART_SIZE, &fig, &mut written)?;
+    }
+    if wants("contact_pressure") && rows.iter().any(|r| r.peak_contact_pressure_pa.is_some()) {
+        let fig = crate::bearing_life::contact_pressure(&grid);
+        write_both(&out_dir, "contact_pressure", CHART_SIZE, &fig, &mut written)?;
     }
     if let Some(rows) = critical.as_ref().filter(|_| wants("critical")) {
         let probability = load_probability(dir)?;

@@ -151,6 +151,10 @@ mod tests {
             max_contact_force_n: None,
             peak_heat_power_w: None,
             peak_temperature_k: None,
+            peak_contact_pressure_pa: None,
+            static_safety_factor: None,
+            drops_to_failure: None,
+            whirl_stop_turns: None,
             error: None,
             duration_s: None,
         };

@@ -170,6 +170,17 @@ pub struct PointRow {
     pub peak_heat_power_w: Option<f64>,
     /// Hottest peak node temperature (K), for records made with the thermal model.
     pub peak_temperature_k: Option<f64>,
+    /// Peak Hertz contact pressure of the most loaded ball (Pa), for records made with the
+    /// bearing analysis.
+    pub peak_contact_pressure_pa: Option<f64>,
+    /// The static limit over that pressure, for records made with the bearing analysis.
+    pub static_safety_factor: Option<f64>,
+    /// Drops of this kind to fatigue failure (L10), for records made with the bearing
+    /// analysis; `None` also when the drop did no damage (an infinite life).
+    pub drops_to_failure: Option<f64>,
+    /// The carried whirl turns after which the run was stopped, for a run stopped as decided
+    /// whirl (its damage is that of these turns only).
+    pub whirl_stop_turns: Option<f64>,
     /// The error of a failed point, as text.
     pub error: Option<String>,
     /// Simulated time asked for (s), when the record says.
@@ -232,6 +243,14 @@ impl From<PointLine> for PointRow {
                         .filter_map(|n| finite(n.get("peak")))
                         .reduce(f64::max)
                 }),
+            peak_contact_pressure_pa: finite(rec.and_then(|v| v.get("peak_contact_pressure_pa"))),
+            static_safety_factor: finite(rec.and_then(|v| v.get("static_safety_factor"))),
+            drops_to_failure: finite(rec.and_then(|v| v.get("drops_to_failure"))),
+            whirl_stop_turns: rec
+                .filter(|v| v.get("stop_reason").and_then(Value::as_str) == Some("whirl_decided"))
+                .and_then(|v| v.get("features"))
+                .and_then(|f| finite(f.get("whirl_streak_turns")))
+                .map(f64::abs),
             error,
             duration_s: r.duration_s,
         }

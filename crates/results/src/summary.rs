@@ -20,6 +20,17 @@ pub const SUMMARY_FIELDS: &[&str] = &[
     "end_time_s",
 ];
 
+/// The bearing analysis's fields of a summary row, after [`SUMMARY_FIELDS`]: columns of a
+/// sweep whose scene turns the analysis on, absent otherwise (so other summaries keep
+/// their columns).
+pub const BEARING_FIELDS: &[&str] = &[
+    "peak_ball_load_n",
+    "peak_contact_pressure_pa",
+    "static_safety_factor",
+    "damage_per_drop",
+    "drops_to_failure",
+];
+
 /// What the summary needs of a drop record.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 pub struct SummaryRecord {
@@ -50,6 +61,22 @@ pub struct SummaryRecord {
     /// Simulated end time (s).
     #[serde(default)]
     pub end_time_s: Option<Number>,
+    /// Peak load on one ball (N), with the bearing analysis.
+    #[serde(default)]
+    pub peak_ball_load_n: Option<Number>,
+    /// Peak contact pressure (Pa), with the bearing analysis.
+    #[serde(default)]
+    pub peak_contact_pressure_pa: Option<Number>,
+    /// Static safety factor against 4.2 GPa, with the bearing analysis.
+    #[serde(default)]
+    pub static_safety_factor: Option<Number>,
+    /// Fatigue damage of the drop, with the bearing analysis.
+    #[serde(default)]
+    pub damage_per_drop: Option<Number>,
+    /// Drops to fatigue failure (empty when the drop did no damage), with the bearing
+    /// analysis.
+    #[serde(default)]
+    pub drops_to_failure: Option<Number>,
 }
 
 /// A point's error: an object with a `message`, or anything else (no message).
@@ -101,14 +128,20 @@ pub struct SummaryRow {
     pub inputs: Vec<f64>,
     /// What its line of `points.jsonl` says; `None` when there is no such line.
     pub source: Option<SummarySource>,
+    /// Whether the row has the [`BEARING_FIELDS`] columns.
+    pub bearing: bool,
 }
 
 impl SummaryRow {
-    /// The header: `index`, the axis names, [`SUMMARY_FIELDS`], `status`, `error`.
-    pub fn header<'a>(axes: impl IntoIterator<Item = &'a str>) -> String {
+    /// The header: `index`, the axis names, [`SUMMARY_FIELDS`], the [`BEARING_FIELDS`] when
+    /// `bearing`, `status`, `error`.
+    pub fn header<'a>(axes: impl IntoIterator<Item = &'a str>, bearing: bool) -> String {
         let mut h = vec!["index".to_string()];
         h.extend(axes.into_iter().map(csv_field));
         h.extend(SUMMARY_FIELDS.iter().map(|s| s.to_string()));
+        if bearing {
+            h.extend(BEARING_FIELDS.iter().map(|s| s.to_string()));
+        }
         h.extend(["status".to_string(), "error".to_string()]);
         h.join(",")
     }
@@ -137,6 +170,17 @@ impl SummaryRow {
             rec.and_then(|r| r.end_time_s.as_ref()),
         ] {
             row.push(num(n));
+        }
+        if self.bearing {
+            for n in [
+                rec.and_then(|r| r.peak_ball_load_n.as_ref()),
+                rec.and_then(|r| r.peak_contact_pressure_pa.as_ref()),
+                rec.and_then(|r| r.static_safety_factor.as_ref()),
+                rec.and_then(|r| r.damage_per_drop.as_ref()),
+                rec.and_then(|r| r.drops_to_failure.as_ref()),
+            ] {
+                row.push(num(n));
+            }
         }
         row.push(text(self.source.as_ref().and_then(|s| s.status.as_ref())));
         let message = match self.source.as_ref().and_then(|s| s.error.as_ref()) {

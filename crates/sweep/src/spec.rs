@@ -41,6 +41,8 @@ pub const CHART_NAMES: &[&str] = &[
     "peak_power",
     "classes",
     "peak_temperature",
+    "drops_to_failure",
+    "contact_pressure",
 ];
 
 /// Largest grid a spec may describe (points). The count is checked, with checked arithmetic,

@@ -365,7 +365,9 @@ pub(crate) fn write_summary(
     let (mut ok, mut failed) = (0, 0);
     let mut read_error: Option<std::io::Error> = None;
     folder::write_atomic_with(&summary_path, |w| {
-        let header = SummaryRow::header(spec.axes.0.iter().map(|a| a.name.as_str()));
+        // The bearing analysis's columns when the scene turns it on.
+        let bearing = spec.scene.bearing.is_some();
+        let header = SummaryRow::header(spec.axes.0.iter().map(|a| a.name.as_str()), bearing);
         writeln!(w, "{header}")?;
         for index in indices {
             let line = match lines.next() {
@@ -393,6 +395,7 @@ pub(crate) fn write_summary(
                 index,
                 inputs: spec.inputs_at(index).iter().map(|(_, x)| *x).collect(),
                 source,
+                bearing,
             };
             writeln!(w, "{}", row.to_csv_line())?;
         }

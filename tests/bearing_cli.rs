@@ -1,0 +1,110 @@
+//! The bearing-survival analysis end to end through the `whirlmap` binary: a drop's record
+//! gains the five fields with `--bearing` and only then, and a sweep whose scene turns the
+//! analysis on writes them to `summary.csv` and draws the drops-to-failure and
+//! contact-pressure charts, whirl cells included.
+
+mod common;
+use common::*;
+
+const FIELDS: [&str; 5] = [
+    "peak_ball_load_n",
+    "peak_contact_pressure_pa",
+    "static_safety_factor",
+    "damage_per_drop",
+    "drops_to_failure",
+];
+
+fn record(extra: &[&str]) -> serde_json::Value {
+    let mut args = vec!["drop", "--duration-s", "0.05", "--json"];
+    args.extend_from_slice(extra);
+    let out = whirlmap(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
+
+#[test]
+fn the_record_has_the_bearing_fields_only_with_the_analysis() {
+    let off = record(&[]);
+    for key in FIELDS {
+        assert!(off.get(key).is_none(), "{key} present without the analysis");
+    }
+    let on = record(&["--bearing"]);
+    for key in FIELDS {
+        let v = on[key].as_f64().unwrap_or(f64::NAN);
+        assert!(v.is_finite() && v > 0.0, "{key}: {}", on[key]);
+    }
+    // The safety factor is the static limit over the peak pressure, and drops to failure
+    // the inverse of the damage.
+    let p = on["peak_contact_pressure_pa"].as_f64().unwrap();
+    let sf = on["static_safety_factor"].as_f64().unwrap();
+    assert!((sf * p / 4.2e9 - 1.0).abs() < 1e-12, "{sf} {p}");
+    let d = on["damage_per_drop"].as_f64().unwrap();
+    let n = on["drops_to_failure"].as_f64().unwrap();
+    assert!((n * d - 1.0).abs() < 1e-12, "{n} {d}");
+}
+
+fn sweep(name: &str, scene: &str) -> std::path::PathBuf {
+    let dir = temp_dir(name);
+    // 2000 r/min at mu 0.1 settles as a pendulum; 16 000 r/min at mu 0.4 whirls.
+    let spec = spec_file(
+        &dir,
+        "spec",
+        &format!(
+            r#"{{"name": "{name}", "scene": {scene}, "duration_s": 0.3,
+                "axes": {{"speed_rpm": {{"from": 2000, "to": 16000, "steps": 2}},
+                          "mu": {{"from": 0.1, "to": 0.4, "steps": 2}}}},
+                "charts": ["drops_to_failure", "contact_pressure", "classes"]}}"#
+        ),
+    );
+    let out_dir = dir.join("out");
+    let out = whirlmap(&["sweep", s(&spec), "--out", s(&out_dir), "--no-progress"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    out_dir
+}
+
+#[test]
+fn a_life_sweep_writes_the_bearing_columns_and_charts() {
+    let out_dir = sweep("life-sweep", r#"{"bearing": {}}"#);
+    let summary = std::fs::read_to_string(out_dir.join("summary.csv")).unwrap();
+    let mut lines = summary.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let records: Vec<serde_json::Value> = std::fs::read_to_string(out_dir.join("points.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let mut classes = Vec::new();
+    for (line, point) in lines.zip(&records) {
+        let cells: Vec<&str> = line.split(',').collect();
+        for key in FIELDS {
+            let csv: f64 = cells[col(key)].parse().expect(key);
+            assert_eq!(csv, point["record"][key].as_f64().unwrap(), "{key}");
+        }
+        classes.push(cells[col("class")].to_string());
+    }
+    assert_eq!(records.len(), 4);
+    assert!(classes.iter().any(|c| c == "backward_whirl"), "{classes:?}");
+    assert!(classes.iter().any(|c| c == "pendulum"), "{classes:?}");
+    for stem in ["drops_to_failure", "contact_pressure", "classes"] {
+        let png = out_dir.join("charts").join(format!("{stem}.png"));
+        assert!(png.exists(), "{png:?}");
+    }
+    // Whirl cells are in the charts' scales, described, not left out.
+    let svg = std::fs::read_to_string(out_dir.join("charts/drops_to_failure.svg")).unwrap();
+    assert!(svg.contains("whirl (hatched): the damage of its first 5 turns only"));
+    assert!(!svg.contains("not in scale"));
+}
+
+#[test]
+fn a_sweep_without_the_analysis_keeps_its_columns() {
+    let out_dir = sweep("no-life-sweep", "{}");
+    let summary = std::fs::read_to_string(out_dir.join("summary.csv")).unwrap();
+    let header = summary.lines().next().unwrap();
+    for key in FIELDS {
+        assert!(!header.contains(key), "{header}");
+    }
+    // Only the class map: the bearing charts need the analysis's results.
+    assert!(out_dir.join("charts/classes.png").exists());
+    assert!(!out_dir.join("charts/drops_to_failure.png").exists());
+}
