@@ -90,7 +90,7 @@ pub fn run(a: &SweepArgs) -> CmdResult {
         }
         outln!("  output           {}", outcome.out_dir.display());
         if spec.scene.bearing.is_some() {
-            for line in bearing_verdict(&outcome.out_dir) {
+            for line in whirlmap_sweep::bearing_report::worst_lines(&outcome.out_dir) {
                 outln!("  {line}");
             }
         }
@@ -115,48 +115,4 @@ pub fn run(a: &SweepArgs) -> CmdResult {
         outln!("  charts           {} files", written.len());
     }
     Ok(Done::flagged_if(done.outcome.failed > 0))
-}
-
-/// The bearing analysis's worst cells of a sweep: the highest contact pressure (the lowest
-/// static safety factor) and the fewest drops to failure, each with where it is and, for a
-/// whirl run, what its damage covers. Empty when the records carry no bearing results.
-fn bearing_verdict(dir: &std::path::Path) -> Vec<String> {
-    let Ok(rows) = whirlmap_sweep::results::point::load_points(dir) else {
-        return Vec::new();
-    };
-    let at = |r: &whirlmap_sweep::results::point::PointRow| {
-        let mut s = format!(
-            "{} r/min, mu {}",
-            r.speed_rpm().map_or("?".to_string(), |v| format!("{v}")),
-            r.mu().map_or("?".to_string(), |v| format!("{v}"))
-        );
-        if let Some(n) = r.whirl_stop_turns {
-            s.push_str(&format!(", a whirl stopped after {n} turns"));
-        }
-        s
-    };
-    let mut lines = Vec::new();
-    let worst = rows
-        .iter()
-        .filter_map(|r| Some((r.static_safety_factor?, r.peak_contact_pressure_pa?, r)))
-        .min_by(|a, b| a.0.total_cmp(&b.0));
-    if let Some((sf, p, r)) = worst {
-        lines.push(format!(
-            "bearing          lowest static safety factor {sf:.2}: peak contact pressure {:.2} GPa against {:.2} GPa ({})",
-            p / 1e9,
-            sf * p / 1e9,
-            at(r)
-        ));
-    }
-    let fewest = rows
-        .iter()
-        .filter_map(|r| r.drops_to_failure.map(|n| (n, r)))
-        .min_by(|a, b| a.0.total_cmp(&b.0));
-    if let Some((n, r)) = fewest {
-        lines.push(format!(
-            "fatigue          fewest drops to failure {n:.3e} (L10; {})",
-            at(r)
-        ));
-    }
-    lines
 }

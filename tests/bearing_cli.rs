@@ -1,7 +1,8 @@
 //! The bearing-survival analysis end to end through the `whirlmap` binary: a drop's record
 //! gains the five fields with `--bearing` and only then, and a sweep whose scene turns the
 //! analysis on writes them to `summary.csv` and draws the drops-to-failure and
-//! contact-pressure charts, whirl cells included.
+//! contact-pressure charts, whirl cells included, and its `bearing.md` report (the same from
+//! merged shards).
 
 mod common;
 use common::*;
@@ -90,10 +91,63 @@ fn a_life_sweep_writes_the_bearing_columns_and_charts() {
         let png = out_dir.join("charts").join(format!("{stem}.png"));
         assert!(png.exists(), "{png:?}");
     }
+    // The report: the verdict against the static limit and in fatigue, the whirl caveat.
+    let report = std::fs::read_to_string(out_dir.join("bearing.md")).unwrap();
+    assert!(
+        report.contains(
+            "- **Static (brinelling, ISO 76):** no drop reaches the static limit of 4.2 GPa"
+        ),
+        "{report}"
+    );
+    assert!(report.contains("- **Fatigue (ISO 281, L10):**"), "{report}");
+    assert!(
+        report.contains("- **Whirl:** 1 of 4 drops end in whirl"),
+        "{report}"
+    );
+    assert!(report.contains("## Assumptions"), "{report}");
+    // The manifest lists it.
+    let manifest = std::fs::read_to_string(out_dir.join("manifest.json")).unwrap();
+    assert!(manifest.contains("\"bearing.md\""), "{manifest}");
     // Whirl cells are in the charts' scales, described, not left out.
     let svg = std::fs::read_to_string(out_dir.join("charts/drops_to_failure.svg")).unwrap();
     assert!(svg.contains("whirl (hatched): the damage of its first 5 turns only"));
     assert!(!svg.contains("not in scale"));
+}
+
+#[test]
+fn merged_shards_write_the_same_bearing_report() {
+    let whole = sweep("life-whole", r#"{"bearing": {}}"#);
+    let dir = temp_dir("life-shards");
+    let spec = whole.parent().unwrap().join("spec.json");
+    let mut shards = Vec::new();
+    for i in 0..2 {
+        let out = dir.join(format!("shard-{i}"));
+        let i = i.to_string();
+        let run = whirlmap(&[
+            "sweep",
+            s(&spec),
+            "--shard",
+            &i,
+            "--shards",
+            "2",
+            "--out",
+            s(&out),
+            "--no-progress",
+        ]);
+        assert!(run.status.success(), "{}", stderr(&run));
+        assert!(
+            !out.join("bearing.md").exists(),
+            "a shard holds part of the grid only"
+        );
+        shards.push(out);
+    }
+    let merged = dir.join("merged");
+    let run = whirlmap(&["merge", s(&shards[0]), s(&shards[1]), "--out", s(&merged)]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert_eq!(
+        std::fs::read(merged.join("bearing.md")).unwrap(),
+        std::fs::read(whole.join("bearing.md")).unwrap()
+    );
 }
 
 #[test]
@@ -107,4 +161,5 @@ fn a_sweep_without_the_analysis_keeps_its_columns() {
     // Only the class map: the bearing charts need the analysis's results.
     assert!(out_dir.join("charts/classes.png").exists());
     assert!(!out_dir.join("charts/drops_to_failure.png").exists());
+    assert!(!out_dir.join("bearing.md").exists());
 }

@@ -12,6 +12,8 @@ pub const POINTS_FILE: &str = "points.jsonl";
 pub const TIMINGS_FILE: &str = "timings.jsonl";
 /// One CSV row per grid point.
 pub const SUMMARY_FILE: &str = "summary.csv";
+/// A sweep's touchdown-bearing survival report, when its scene turns the bearing analysis on.
+pub const BEARING_REPORT_FILE: &str = "bearing.md";
 /// Run metadata and the list of every file the run wrote.
 pub const MANIFEST_FILE: &str = "manifest.json";
 /// Critical-speed results (a JSON list of [`crate::critical::CriticalRow`]).

@@ -36,9 +36,9 @@ use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use whirlmap_results::files::{
-    CHARTS_DIR, COMPARE_CLASSES_FILE, COMPARE_REPORT_FILE, CONTOURS_FILE, CRITICAL_CSV_FILE,
-    CRITICAL_FILE, MANIFEST_FILE, ORBITS_DIR, POINTS_FILE, PROBABILITY_DIR, SHARD_FILE,
-    SUMMARY_FILE, TIMINGS_FILE,
+    BEARING_REPORT_FILE, CHARTS_DIR, COMPARE_CLASSES_FILE, COMPARE_REPORT_FILE, CONTOURS_FILE,
+    CRITICAL_CSV_FILE, CRITICAL_FILE, MANIFEST_FILE, ORBITS_DIR, POINTS_FILE, PROBABILITY_DIR,
+    SHARD_FILE, SUMMARY_FILE, TIMINGS_FILE,
 };
 use whirlmap_results::manifest::{Manifest, ShardTag};
 
@@ -49,6 +49,7 @@ pub const OWNED: &[&str] = &[
     POINTS_FILE,
     TIMINGS_FILE,
     SUMMARY_FILE,
+    BEARING_REPORT_FILE,
     MANIFEST_FILE,
     CRITICAL_FILE,
     CRITICAL_CSV_FILE,
@@ -64,6 +65,7 @@ pub const OWNED: &[&str] = &[
 /// The derived names a `--resume` removes before it makes them again.
 const DERIVED: &[&str] = &[
     SUMMARY_FILE,
+    BEARING_REPORT_FILE,
     CRITICAL_FILE,
     CRITICAL_CSV_FILE,
     ORBITS_DIR,

@@ -606,6 +606,9 @@ pub fn merge(
     for f in [POINTS_FILE, TIMINGS_FILE, SUMMARY_FILE] {
         out.record(f)?;
     }
+    if crate::bearing_report::write(&spec, out_dir)?.is_some() {
+        out.record(crate::sweep::BEARING_REPORT_FILE)?;
+    }
     record.counts = Some(crate::sweep::Counts {
         points: n_points,
         ok,

@@ -58,7 +58,9 @@ use whirlmap_results::manifest::{Manifest, MergedShard, ShardTag, TimingRow};
 use whirlmap_results::point::PointLine;
 use whirlmap_results::summary::{SummaryRow, SummarySource};
 
-pub use whirlmap_results::files::{MANIFEST_FILE, POINTS_FILE, SUMMARY_FILE, TIMINGS_FILE};
+pub use whirlmap_results::files::{
+    BEARING_REPORT_FILE, MANIFEST_FILE, POINTS_FILE, SUMMARY_FILE, TIMINGS_FILE,
+};
 
 /// Why a sweep could not run or write its outputs (failed points are not errors).
 #[derive(Debug, Error)]
@@ -834,6 +836,10 @@ pub fn run_grid(
     run.folder.record(POINTS_FILE)?;
     run.folder.record(TIMINGS_FILE)?;
     run.folder.record(SUMMARY_FILE)?;
+    // A shard holds part of the grid: its merge writes the report.
+    if shard.is_none() && crate::bearing_report::write(spec, &out)?.is_some() {
+        run.folder.record(BEARING_REPORT_FILE)?;
+    }
     run.record.counts = Some(Counts {
         points: total,
         ok,
