@@ -6,13 +6,13 @@
 #   scripts/regenerate-results.sh [PART...]
 #
 # PART is one of: paper radial reference physics nightly ensemble adaptive accuracy drops
-# thermal (default: all). About 40 minutes on two cores in all; `paper` alone about one.
+# thermal life (default: all). About 40 minutes on two cores in all; `paper` alone about one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --quiet
 W=target/release/whirlmap
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(paper radial reference physics nightly ensemble adaptive accuracy drops thermal)
+[ ${#parts[@]} -eq 0 ] && parts=(paper radial reference physics nightly ensemble adaptive accuracy drops thermal life)
 
 # `compare` exits 1 when the runs differ, which is the point of these comparisons.
 compare() { "$W" compare "$@" || [ $? -eq 1 ]; }
@@ -66,6 +66,11 @@ for part in "${parts[@]}"; do
         --temperatures results/reference/coast-down.png > /dev/null
       "$W" drop --scene scenes/runaway.json --duration-s 60 \
         --temperatures results/reference/runaway-60s.png > /dev/null ;;
+    life)
+      # Does the touchdown bearing survive? Drops to failure and contact pressure over
+      # speed x friction, with the survival report bearing.md.
+      rm -rf results/life
+      "$W" sweep sweeps/life.json --no-progress ;;
     *)
       echo "unknown part: $part" >&2
       exit 2 ;;
