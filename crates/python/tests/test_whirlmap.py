@@ -77,6 +77,29 @@ def test_overrides_reach_the_scene() -> None:
     assert whirlmap.drop(4000, 0.1, duration_s=0.05, series=False).record != r.record
 
 
+BEARING_FIELDS = (
+    "peak_ball_load_n",
+    "peak_contact_pressure_pa",
+    "static_safety_factor",
+    "damage_per_drop",
+    "drops_to_failure",
+)
+
+
+def test_bearing_analysis_fields() -> None:
+    off = whirlmap.drop(8000, 0.1, duration_s=0.05, series=False)
+    assert not set(BEARING_FIELDS) & set(off.record)
+    on = whirlmap.drop(8000, 0.1, duration_s=0.05, series=False, bearing={})
+    rec = on.record
+    for key in BEARING_FIELDS:
+        assert math.isfinite(rec[key]) and rec[key] > 0, key
+    # The analysis only reads the motion: the dynamics are those of the drop without it.
+    assert rec["max_contact_force_n"] == off.record["max_contact_force_n"]
+    assert rec["static_safety_factor"] * rec["peak_contact_pressure_pa"] == pytest.approx(4.2e9)
+    assert rec["drops_to_failure"] * rec["damage_per_drop"] == pytest.approx(1.0)
+    assert on.scene["bearing"]["balls_per_row"] == 22
+
+
 def test_a_bad_value_names_the_field_value_and_range() -> None:
     with pytest.raises(ValueError) as e:
         whirlmap.drop(8000, 0.3, duration_s=0.1, clearance_m=-1)
