@@ -122,41 +122,57 @@ impl<const N: usize> Rodas4<N> {
         h: f64,
     ) -> ([f64; N], f64) {
         let hg = h * GAMMA;
-        let mut u = [[0.0; N]; 6];
-        let mut r = [0.0; N];
-        for i in 0..N {
-            r[i] = hg * f0[i];
+        // The stages, unrolled: `sum_j coef_j u_j` with a constant number of terms.
+        #[inline(always)]
+        fn comb<const N: usize, const M: usize>(c: &[f64], u: &[[f64; N]; 6]) -> [f64; N] {
+            let mut v = [0.0; N];
+            for j in 0..M {
+                for i in 0..N {
+                    v[i] += c[j] * u[j][i];
+                }
+            }
+            v
         }
-        lu.solve(&mut r);
-        u[0] = r;
+        let mut u = [[0.0; N]; 6];
+        for i in 0..N {
+            u[0][i] = hg * f0[i];
+        }
+        lu.solve(&mut u[0]);
         let mut yt = [0.0; N];
         let mut f = [0.0; N];
-        for s in 1..6 {
-            if s < 5 {
+        // Stage s (0-based, 1..=5) at `yt` from the `s` stages before it.
+        macro_rules! stage {
+            ($s:literal, $m:literal) => {{
+                sys.rhs(t + C[$s] * h, &yt, &mut f);
+                let v = comb::<N, $m>(&CC[$s], &u);
+                let r = &mut u[$s];
                 for i in 0..N {
-                    let mut v = y[i];
-                    for j in 0..s {
-                        v += A[s][j] * u[j][i];
-                    }
-                    yt[i] = v;
+                    r[i] = hg * f[i] + GAMMA * v[i];
                 }
-            } else {
-                // Y_6 = Y_5 + u_5: the embedded solution.
-                for i in 0..N {
-                    yt[i] += u[4][i];
-                }
-            }
-            sys.rhs(t + C[s] * h, &yt, &mut f);
-            for i in 0..N {
-                let mut v = 0.0;
-                for j in 0..s {
-                    v += CC[s][j] * u[j][i];
-                }
-                r[i] = hg * f[i] + GAMMA * v;
-            }
-            lu.solve(&mut r);
-            u[s] = r;
+                lu.solve(r);
+            }};
         }
+        macro_rules! point {
+            ($s:literal, $m:literal) => {{
+                let v = comb::<N, $m>(&A[$s], &u);
+                for i in 0..N {
+                    yt[i] = y[i] + v[i];
+                }
+            }};
+        }
+        point!(1, 1);
+        stage!(1, 1);
+        point!(2, 2);
+        stage!(2, 2);
+        point!(3, 3);
+        stage!(3, 3);
+        point!(4, 4);
+        stage!(4, 4);
+        // Y_6 = Y_5 + u_5: the embedded solution.
+        for i in 0..N {
+            yt[i] += u[4][i];
+        }
+        stage!(5, 5);
         core.stats.rhs_evals += 5;
         let mut y1 = [0.0; N];
         let mut err = 0.0;
