@@ -15,7 +15,10 @@
 //!
 //! Unlike a W-method, a Rosenbrock method keeps its order only with the exact Jacobian: with
 //! the system's approximate stiff Jacobian ([`super::OdeSystem::stiff_jacobian`]) the order of
-//! the terms the matrix leaves out drops (the stepper harness measures it). Dense output and
+//! the terms the matrix leaves out drops (the stepper harness measures it). On the drop model
+//! this shows in the energy integrals (`E_FRIC`, `E_DAMP`: rows the stiff Jacobian does not
+//! hold): at an impact their error estimate, not the motion's, bounds the step (measured: with
+//! them left out of the norm, 10-25 % fewer steps on the 1 s drops). Dense output and
 //! the reuse of the end's derivative are ROS34PW2's: the cubic Hermite interpolant of the
 //! step's ends.
 
