@@ -7,8 +7,8 @@ use crate::error::{InvalidParameter, SolveError};
 use crate::model::{ix, DropSystem, Mode, N};
 use crate::monitor::{Features, Monitor, WhirlDecided};
 use crate::ode::{
-    run_hybrid, Dop853, Dopri5, Finish, HybridObserver, JumpRules, NoObserver, Observer, Ros34pw2,
-    Stats, StepControl, StepView, Stepper,
+    run_hybrid, Dop853, Dopri5, Finish, HybridObserver, JumpRules, NoObserver, Observer, Rodas4,
+    Ros34pw2, Stats, StepControl, StepView, Stepper,
 };
 use crate::orbit::Orbit;
 use crate::scene::{Method, Scene};
@@ -408,6 +408,7 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
         Method::Dopri5 => run_with(scene, opts, extra, sys, Dopri5::new(ctl)),
         Method::Dop853 => run_with(scene, opts, extra, sys, Dop853::new(ctl)),
         Method::Ros34pw2 => run_with(scene, opts, extra, sys, Ros34pw2::new(ctl)),
+        Method::Rodas4 => run_with(scene, opts, extra, sys, Rodas4::new(ctl)),
     }
 }
 

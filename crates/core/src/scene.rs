@@ -43,6 +43,9 @@ pub enum Method {
     /// 2005) with an analytic stiff Jacobian: its step is not bounded by the light race's
     /// contact mode (`ode/rosw.rs`). The `draft` fidelity's.
     Ros34pw2,
+    /// RODAS4, a Rosenbrock method of order 4 (Hairer and Wanner) on the same stiff Jacobian
+    /// and factors as ROS34PW2 (`ode/rodas.rs`). In no fidelity preset.
+    Rodas4,
 }
 
 /// How the race-on-balls damper c2 of Table 4 acts on the race's velocity.

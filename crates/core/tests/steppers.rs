@@ -1,5 +1,5 @@
 //! One harness for the steppers' order and tolerance: every stepper (DOPRI5, DOP853,
-//! ROS34PW2) runs a set of reference problems with closed-form solutions, and for each the
+//! ROS34PW2, RODAS4) runs a set of reference problems with closed-form solutions, and for each the
 //! harness checks
 //!
 //! - the observed convergence order on fixed steps (the error of `h` against `h / 2`) is the
@@ -8,13 +8,14 @@
 //!   tightens, stays within a small multiple of `rtol`, and falls at a rate close to `rtol`'s.
 //!
 //! The problems: exponential decay at two rates, the harmonic oscillator, for the implicit
-//! stepper also the harmonic oscillator with a deliberately wrong Jacobian (a W-method keeps
-//! its order with any matrix) and a stiff linear system (eigenvalues -1 and -1000) whose
-//! solution lies on the slow manifold.
+//! steppers also a stiff linear system (eigenvalues -1 and -1000) whose solution lies on the
+//! slow manifold, and for the W-method also the harmonic oscillator with a deliberately wrong
+//! Jacobian (a W-method keeps its order with any matrix; the Rosenbrock method does not, which
+//! the last test shows). The observed orders and slopes print with `--nocapture`.
 
 use whirlmap_core::ode::{
-    integrate, Dop853, Dopri5, NoGuard, NoObserver, OdeSystem, Ros34pw2, StepControl, Stepper,
-    StiffJacobian, Stop,
+    integrate, Dop853, Dopri5, NoGuard, NoObserver, OdeSystem, Rodas4, Ros34pw2, StepControl,
+    Stepper, StiffJacobian, Stop,
 };
 
 /// A reference problem: a two-component system with its exact solution.
@@ -146,6 +147,9 @@ struct Method {
     rtols: [f64; 3],
     /// Whether it runs the stiff problems.
     implicit: bool,
+    /// Whether it is a W-method (its order holds with any matrix), so it runs the problem
+    /// with a wrong Jacobian too.
+    w_method: bool,
 }
 
 /// Object-safe wrapper over the steppers: one run of a reference problem to its end.
@@ -200,7 +204,7 @@ impl<M: Stepper<2>> StepperBox for M {
     }
 }
 
-fn methods() -> [Method; 3] {
+fn methods() -> [Method; 4] {
     [
         Method {
             name: "DOPRI5",
@@ -209,6 +213,7 @@ fn methods() -> [Method; 3] {
             steps: 40,
             rtols: [1e-4, 1e-7, 1e-10],
             implicit: false,
+            w_method: false,
         },
         Method {
             name: "DOP853",
@@ -217,6 +222,7 @@ fn methods() -> [Method; 3] {
             steps: 10,
             rtols: [1e-6, 1e-9, 1e-12],
             implicit: false,
+            w_method: false,
         },
         Method {
             name: "ROS34PW2",
@@ -225,6 +231,17 @@ fn methods() -> [Method; 3] {
             steps: 200,
             rtols: [1e-4, 1e-6, 1e-8],
             implicit: true,
+            w_method: true,
+        },
+        Method {
+            name: "RODAS4",
+            order: 4.0,
+            make: |c| Box::new(Rodas4::new(c)),
+            steps: 100,
+            rtols: [1e-4, 1e-6, 1e-8],
+            implicit: true,
+            // A Rosenbrock method: its order needs the exact Jacobian (see the test below).
+            w_method: false,
         },
     ]
 }
@@ -257,10 +274,12 @@ fn problems(m: &Method) -> Vec<Case> {
             wrong_jacobian: false,
         }),
     ];
-    if m.implicit {
+    if m.w_method {
         v.push(Case::of(Harmonic {
             wrong_jacobian: true,
         }));
+    }
+    if m.implicit {
         v.push(Case::of(StiffLinear));
     }
     v
@@ -293,6 +312,7 @@ fn fixed_steps_converge_at_each_methods_order() {
             };
             let (e1, e2) = (err_at(m.steps), err_at(2 * m.steps));
             let order = (e1 / e2).log2();
+            println!("{} on {name}: observed order {order:.2}", m.name);
             assert!(
                 (order - m.order).abs() < 0.1 * m.order,
                 "{} on {name}: observed order {order:.2}, expected {} ({e1:e} -> {e2:e})",
@@ -337,6 +357,7 @@ fn global_error_falls_in_proportion_to_the_tolerance() {
             // The error falls at a rate close to the tolerance's: its slope against rtol on
             // a log scale, from the loosest to the tightest.
             let slope = (errs[0] / errs[2]).ln() / (m.rtols[0] / m.rtols[2]).ln();
+            println!("{} on {name}: errors {errs:?}, slope {slope:.2}", m.name);
             assert!(
                 errs[1] < errs[0] && errs[2] < errs[1] && (0.8..=1.2).contains(&slope),
                 "{} on {name}: errors {errs:?} for rtol {:?} (slope {slope:.2})",
@@ -345,4 +366,32 @@ fn global_error_falls_in_proportion_to_the_tolerance() {
             );
         }
     }
+}
+
+/// RODAS4 is a Rosenbrock method, not a W-method: with a matrix that is not the Jacobian it
+/// still converges, but at a low order (its order conditions beyond the first assume the
+/// exact Jacobian), unlike ROS34PW2, which keeps order 3 on the same problem (above).
+#[test]
+fn rodas4_loses_its_order_with_a_wrong_jacobian() {
+    let p = Harmonic {
+        wrong_jacobian: true,
+    };
+    let exact = p.exact(p.t_end());
+    let err_at = |n: usize| {
+        let ctl = StepControl {
+            rtol: 1.0,
+            atol: [1.0; 2],
+            h_min: 0.0,
+            max_attempts: u64::MAX,
+            fixed_step: Some(p.t_end() / n as f64),
+        };
+        error(Rodas4::new(ctl).run(&p), exact)
+    };
+    let (e1, e2, e3) = (err_at(400), err_at(800), err_at(1600));
+    let order = (e2 / e3).log2();
+    println!("RODAS4, wrong Jacobian: observed order {order:.2}");
+    assert!(
+        e2 < e1 && (0.8..2.5).contains(&order),
+        "observed order {order:.2} ({e1:e} -> {e2:e} -> {e3:e})"
+    );
 }

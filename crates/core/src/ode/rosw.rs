@@ -56,9 +56,9 @@ const BHAT: [f64; 4] = [
 /// costs 3 % more instructions on the standard 1 s drop (94.4 M against 91.7 M, callgrind).
 /// Other shapes (the stepper's tests) use nalgebra's LU in dynamic storage.
 #[derive(Debug, Clone)]
-struct Lu {
+pub(super) struct Lu {
     /// `J` itself, for the `J v` products of the stage right-hand sides (`len` 0: none).
-    j: StiffJacobian,
+    pub(super) j: StiffJacobian,
     /// The factors of `W` (no kinematic components) or of its Schur complement `S`.
     factors: Factors,
     /// `h gamma` of the factorisation.
@@ -80,7 +80,7 @@ enum Factors {
 }
 
 impl Lu {
-    fn identity() -> Self {
+    pub(super) fn identity() -> Self {
         Self {
             j: StiffJacobian::over(&[]),
             factors: Factors::Identity,
@@ -104,7 +104,7 @@ impl Lu {
     }
 
     /// Factors `I - hg J`; false if singular (the caller shrinks the step).
-    fn factor(&mut self, hg: f64) -> bool {
+    pub(super) fn factor(&mut self, hg: f64) -> bool {
         let (n, k) = (self.j.len, self.j.kinematic);
         debug_assert!(2 * k <= n, "kinematic {k} of {n} components");
         debug_assert!(
@@ -154,7 +154,7 @@ impl Lu {
     /// Solves `W x = v` in place (components outside the stiff set are untouched: W is the
     /// identity there).
     #[inline]
-    fn solve<const N: usize>(&self, v: &mut [f64; N]) {
+    pub(super) fn solve<const N: usize>(&self, v: &mut [f64; N]) {
         // The model's shape gets constant loop bounds (unrolled, no bounds checks): the
         // stepper spends most of its time in these loops.
         match (self.j.len, self.j.kinematic) {
