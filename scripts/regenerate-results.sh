@@ -48,7 +48,8 @@ for part in "${parts[@]}"; do
         "$W" adaptive "sweeps/$s.json" --compare-full --no-progress
       done ;;
     accuracy)
-      for s in accuracy:accuracy-cases accuracy-radial:accuracy-radial accuracy-implicit:accuracy-implicit; do
+      for s in accuracy:accuracy-cases accuracy-radial:accuracy-radial accuracy-implicit:accuracy-implicit \
+               accuracy-rodas4:accuracy-rodas4; do
         out=${s%%:*}; cases=${s##*:}
         rm -rf "results/$out"
         "$W" accuracy --cases "sweeps/$cases.json" --out "results/$out"

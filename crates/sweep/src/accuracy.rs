@@ -555,7 +555,8 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
         for r in study.rows.iter().filter(|r| r.case == reference.case) {
             match &r.result {
                 Ok((m, e)) => out.push_str(&format!(
-                    "| {} | {:.0e} | {}{} | {} | {} | {} | {:.2e} | {} | {} | {} | {:.1} |\n",
+                    // `{:e}`: the shortest exact form, so 2.5e-5 stays 2.5e-5.
+                    "| {} | {:e} | {}{} | {} | {} | {} | {:.2e} | {} | {} | {} | {:.1} |\n",
                     r.setting,
                     r.rtol,
                     m.class.name(),
@@ -570,7 +571,7 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
                     m.wall_ms
                 )),
                 Err(e) => out.push_str(&format!(
-                    "| {} | {:.0e} | failed: {} | | | | | | | | |\n",
+                    "| {} | {:e} | failed: {} | | | | | | | | |\n",
                     r.setting, r.rtol, e
                 )),
             }
