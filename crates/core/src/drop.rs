@@ -444,14 +444,8 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
         Some(p) => Some(ThermalRun::new(scene, p, opts.duration_s, &y)?),
         None => None,
     };
-    let bearing = match &scene.bearing {
-        Some(pair) => {
-            let mut pair = pair.clone();
-            if scene.support_exponent == 1.5 {
-                pair.lumped_stiffness_n_per_m1_5 = scene.support_stiffness_n_per_m_e;
-            }
-            Some(BearingAnalysis::new(&pair)?)
-        }
+    let bearing = match scene.bearing_as_run() {
+        Some(pair) => Some(BearingAnalysis::new(&pair)?),
         None => None,
     };
     let mut tap = Tap {

@@ -350,6 +350,18 @@ fn is_zero2(v: &[f64; 2]) -> bool {
 }
 
 impl Scene {
+    /// The bearing pair the analysis runs with, if the scene turns it on: the scene's
+    /// `bearing`, with its lumped stiffness taken from the support law (k2, eq. 7) when the
+    /// support exponent is Hertz's 1.5, so that the ball loads resolve to the force the
+    /// dynamics apply.
+    pub fn bearing_as_run(&self) -> Option<crate::bearing::BearingPair> {
+        let mut pair = self.bearing.clone()?;
+        if self.support_exponent == 1.5 {
+            pair.lumped_stiffness_n_per_m1_5 = self.support_stiffness_n_per_m_e;
+        }
+        Some(pair)
+    }
+
     /// Fields left out of the serialised scene while at their default (so adding them did
     /// not change existing scene hashes), dotted for nested fields; settable by name all the
     /// same (`--set`). A test checks this is exactly the set of fields the JSON can omit.

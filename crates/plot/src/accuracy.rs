@@ -66,6 +66,13 @@ struct WorkPrecision {
     settings: Vec<String>,
 }
 
+/// Settings past the palette's ten colours are drawn dashed.
+fn dashed(i: usize) -> bool {
+    (PALETTE_LEN..2 * PALETTE_LEN).contains(&(i % (2 * PALETTE_LEN)))
+}
+
+const PALETTE_LEN: usize = 10;
+
 fn colour(i: usize) -> RGBColor {
     const P: [RGBColor; 10] = [
         RGBColor(31, 119, 180),
@@ -180,16 +187,19 @@ impl WorkPrecision {
             .light_line_style(GRID_LIGHT.stroke_width(1))
             .draw()?;
         for (i, line) in p.lines.iter().enumerate() {
-            let c = colour(
-                self.settings
-                    .iter()
-                    .position(|s| *s == line.setting)
-                    .unwrap_or(i),
-            );
-            chart.draw_series(LineSeries::new(
-                line.points.iter().map(|&(x, y, _)| (x, y)),
-                c.stroke_width(2),
-            ))?;
+            let k = self
+                .settings
+                .iter()
+                .position(|s| *s == line.setting)
+                .unwrap_or(i);
+            let c = colour(k);
+            let points = line.points.iter().map(|&(x, y, _)| (x, y));
+            // The palette's second round is dashed, so no two settings look alike.
+            if dashed(k) {
+                chart.draw_series(DashedLineSeries::new(points, 7, 4, c.stroke_width(2)))?;
+            } else {
+                chart.draw_series(LineSeries::new(points, c.stroke_width(2)))?;
+            }
             for &(x, y, agrees) in &line.points {
                 if agrees {
                     chart.draw_series(std::iter::once(Circle::new((x, y), 4, c.filled())))?;
@@ -218,7 +228,14 @@ impl Figure for WorkPrecision {
             .settings
             .iter()
             .enumerate()
-            .map(|(i, s)| (LegendMark::Line(colour(i)), s.as_str()))
+            .map(|(i, s)| {
+                let mark = if dashed(i) {
+                    LegendMark::Dashed(colour(i))
+                } else {
+                    LegendMark::Line(colour(i))
+                };
+                (mark, s.as_str())
+            })
             .collect();
         let half = entries.len().div_ceil(2);
         draw_legend_row(&l1, &entries[..half])?;

@@ -13,7 +13,7 @@ use crate::render::format_quantity;
 pub const ISO76_LIMIT_GPA: f64 = 4.2;
 
 /// The static limit the records were judged against (GPa), from their pressure times their
-/// safety factor (the limit over the pressure), rounded to 4 digits; `None` when the records
+/// safety factor (the limit over the pressure), rounded to the MPa; `None` when the records
 /// disagree (a sweep over the limit) or carry none.
 fn static_limit_gpa(grid: &Grid) -> Option<f64> {
     let limits = distinct_sorted(grid.rows.iter().filter_map(|r| {
@@ -38,10 +38,10 @@ fn whirl_words(grid: &Grid, what: &str) -> String {
     let turns = distinct_sorted(grid.rows.iter().filter_map(|r| r.whirl_stop_turns));
     match turns.as_slice() {
         [n] => format!(
-            "whirl (hatched): {what} its first {} turns only (the run stops there)",
-            plain(*n)
+            "whirl (hatched): {what} the run up to its {} whirl turn (it stops there)",
+            ordinal(*n)
         ),
-        _ => format!("whirl (hatched): {what} the turns before the run stopped only"),
+        _ => format!("whirl (hatched): {what} the run up to the whirl turn it stopped at"),
     }
 }
 
@@ -52,6 +52,19 @@ fn plain(x: f64) -> String {
     } else {
         format_quantity(x)
     }
+}
+
+/// "5th", "1st", "22nd": the turn the run stopped at.
+fn ordinal(n: f64) -> String {
+    let k = n.round() as i64;
+    let suffix = match (k % 10, k % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{}{suffix}", plain(n))
 }
 
 /// The simulated duration of the drops, as "1 s", when all say the same.
@@ -73,9 +86,15 @@ pub(crate) fn drops_to_failure(grid: &Grid) -> GridFigure<'_> {
         grid,
         title: with_slice(&title, &grid.slice),
         mode: GridMode::Metric(Metric {
-            value: |r| r.drops_to_failure,
+            // A drop that loads the bearing and does no damage has an infinite life (the
+            // record's null); a drop without the analysis has no value.
+            value: |r| {
+                r.drops_to_failure
+                    .or(r.peak_contact_pressure_pa.map(|_| f64::INFINITY))
+            },
             whirl_in_scale: true,
             log: true,
+            infinite_label: Some("no damage: infinite life"),
         }),
         bar_label: "drops to failure (log scale)",
         whirl_label: Some(whirl_words(grid, "the damage of")),
@@ -96,9 +115,10 @@ pub(crate) fn contact_pressure(grid: &Grid) -> GridFigure<'_> {
             value: |r| r.peak_contact_pressure_pa.map(|p| p / 1e9),
             whirl_in_scale: true,
             log: false,
+            infinite_label: None,
         }),
         bar_label: "peak contact pressure (GPa)",
-        whirl_label: Some(whirl_words(grid, "the peak over")),
+        whirl_label: Some(whirl_words(grid, "the peak of")),
         limit: static_limit_gpa(grid).map(|gpa| Limit {
             value: gpa,
             name: if gpa == ISO76_LIMIT_GPA {

@@ -35,7 +35,7 @@ pub(crate) struct ColourBar<'a> {
     pub(crate) label: &'a str,
     /// A tick's text on a log scale (a linear scale uses the shared tick formatter).
     pub(crate) tick: &'a dyn Fn(&f64) -> String,
-    /// Whether the scale is logarithmic (ticks then fall on whole decades).
+    /// Whether the scale is logarithmic (then about one tick per decade, labelled by `tick`).
     pub(crate) log: bool,
 }
 

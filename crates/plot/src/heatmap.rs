@@ -60,6 +60,9 @@ pub(crate) enum CellKind {
     Value(f64),
     /// A whirl cell whose value stays in the scale ([`Metric::whirl_in_scale`]).
     WhirlValue(f64, OrbitClass),
+    /// An infinite value (a drop that did no damage lasts forever): drawn in the colour of
+    /// the scale's top, named in the legend.
+    Infinite,
     Class(OrbitClass),
     NoValue,
 }
@@ -75,6 +78,9 @@ pub(crate) struct Metric {
     /// A logarithmic colour scale, with the decades as contour levels (values must be
     /// positive; others are left out).
     pub(crate) log: bool,
+    /// The legend's words for an infinite value, when the metric has them ("no damage:
+    /// infinite life"); without, infinite values are "infinite".
+    pub(crate) infinite_label: Option<&'static str>,
 }
 
 /// A limit drawn on a heat map as its own dashed contour where the values cross it; the
@@ -95,6 +101,7 @@ impl Metric {
             value,
             whirl_in_scale: false,
             log: false,
+            infinite_label: None,
         }
     }
 
@@ -159,9 +166,10 @@ impl GridFigure<'_> {
             GridMode::Classes | GridMode::MarkedClasses(_) => CellKind::Class(class),
             GridMode::Metric(m) if class.is_whirl() && !m.whirl_in_scale => CellKind::Whirl(class),
             GridMode::Metric(_) if class == OrbitClass::Unresolved => CellKind::Unresolved,
-            GridMode::Metric(m) => match m.scaled(row).map(clamp_value) {
-                Some(v) if class.is_whirl() => CellKind::WhirlValue(v, class),
-                Some(v) => CellKind::Value(v),
+            GridMode::Metric(m) => match m.scaled(row) {
+                Some(v) if v == f64::INFINITY => CellKind::Infinite,
+                Some(v) if class.is_whirl() => CellKind::WhirlValue(clamp_value(v), class),
+                Some(v) => CellKind::Value(clamp_value(v)),
                 None => CellKind::NoValue,
             },
         }
@@ -242,7 +250,9 @@ impl Figure for GridFigure<'_> {
         let canvas = pa.strip_coord_spec();
         let (mut any_failed, mut any_empty, mut any_unresolved) = (false, false, false);
         let mut whirl_seen = [false, false];
-        let mut whirl_in_scale_seen = false;
+        // Whirl cells in the scale seen: [backward, forward].
+        let mut whirl_in_scale_seen = [false, false];
+        let mut any_infinite = false;
         for j in 0..ny {
             for i in 0..nx {
                 let tl = px(xe[i], ye[j + 1]);
@@ -256,10 +266,16 @@ impl Figure for GridFigure<'_> {
                         canvas.draw(&Rectangle::new([tl, br], c.filled()))?;
                     }
                     CellKind::WhirlValue(v, c) => {
-                        whirl_in_scale_seen = true;
+                        whirl_in_scale_seen[(c == OrbitClass::ForwardWhirl) as usize] = true;
                         let (lo, hi) = scale.unwrap_or((0.0, 1.0));
                         canvas.draw(&Rectangle::new([tl, br], scale_colour(v, lo, hi).filled()))?;
                         hatch_in(&canvas, tl, br, c == OrbitClass::ForwardWhirl, WHIRL_OVER)?;
+                    }
+                    CellKind::Infinite => {
+                        any_infinite = true;
+                        let (lo, hi) = scale.unwrap_or((0.0, 1.0));
+                        canvas
+                            .draw(&Rectangle::new([tl, br], scale_colour(hi, lo, hi).filled()))?;
                     }
                     CellKind::Class(c) => {
                         canvas.draw(&Rectangle::new([tl, br], class_colour(c).filled()))?;
@@ -315,13 +331,28 @@ impl Figure for GridFigure<'_> {
                     _ => nice_levels(lo, hi, 6),
                 };
             }
-            let z: Vec<f64> = kinds
-                .iter()
-                .map(|k| match k {
-                    CellKind::Value(v) | CellKind::WhirlValue(v, _) => *v,
-                    _ => f64::NAN,
-                })
-                .collect();
+            // With whirl cells in the scale, the whirl runs (stopped after a few turns) and
+            // the others are contoured apart: no line joins a cell of one to the other.
+            let population = |whirl: bool| -> Vec<f64> {
+                kinds
+                    .iter()
+                    .map(|k| match k {
+                        CellKind::Value(v) if !whirl => *v,
+                        CellKind::WhirlValue(v, _) if whirl => *v,
+                        _ => f64::NAN,
+                    })
+                    .collect()
+            };
+            let zs: Vec<Vec<f64>> = if m.whirl_in_scale {
+                vec![population(false), population(true)]
+            } else {
+                vec![population(false)]
+            };
+            let trace = |level: f64| -> Vec<[(f64, f64); 2]> {
+                zs.iter()
+                    .flat_map(|z| marching_squares(&g.speeds_rpm, &g.mus, z, level))
+                    .collect()
+            };
             // A level just inside the range of the values cuts one corner of one cell: a
             // stray dot, not a line. A level whose contour is shorter than 30 pixels in all
             // is left out (here and on the colour bar).
@@ -331,7 +362,7 @@ impl Figure for GridFigure<'_> {
             };
             let contours: Vec<_> = levels
                 .iter()
-                .map(|&level| (level, marching_squares(&g.speeds_rpm, &g.mus, &z, level)))
+                .map(|&level| (level, trace(level)))
                 .filter(|(_, segs)| segs.iter().map(seg_px).sum::<f64>() >= 30.0)
                 .collect();
             levels = contours.iter().map(|(level, _)| *level).collect();
@@ -357,7 +388,7 @@ impl Figure for GridFigure<'_> {
                 }
             }
             if let Some((l, name, unit)) = limit {
-                let segs = marching_squares(&g.speeds_rpm, &g.mus, &z, l);
+                let segs = trace(l);
                 for s in &segs {
                     canvas.draw(&DashedPathElement::new(
                         vec![px(s[0].0, s[0].1), px(s[1].0, s[1].1)],
@@ -375,16 +406,16 @@ impl Figure for GridFigure<'_> {
                     _ => name.to_string(),
                 });
             }
-            if values.is_empty() {
-                let (w, h) = canvas.dim_in_pixel();
-                boxed_text(
-                    &canvas,
-                    "no values in scale",
-                    (w as i32 / 2, h as i32 / 2),
-                    CAPTION_FONT,
-                    CONTOUR,
-                )?;
-            }
+        }
+        if metric.is_some() && values.is_empty() {
+            let (w, h) = canvas.dim_in_pixel();
+            boxed_text(
+                &canvas,
+                "no values in scale",
+                (w as i32 / 2, h as i32 / 2),
+                CAPTION_FONT,
+                CONTOUR,
+            )?;
         }
 
         // Legend.
@@ -413,14 +444,22 @@ impl Figure for GridFigure<'_> {
                     entries.push((Mark::Dashed(LIMIT), text));
                 }
                 if m.whirl_in_scale {
-                    if whirl_in_scale_seen {
+                    if whirl_in_scale_seen[0] {
                         let (lo, hi) = scale.unwrap_or((0.0, 1.0));
                         let mid = scale_colour((lo + hi) / 2.0, lo, hi);
                         let label = self
                             .whirl_label
                             .clone()
                             .unwrap_or_else(|| "whirl (in scale)".to_string());
-                        entries.push((Mark::HatchOver(mid), label));
+                        entries.push((Mark::HatchOver(mid, false), label));
+                    }
+                    if whirl_in_scale_seen[1] {
+                        let (lo, hi) = scale.unwrap_or((0.0, 1.0));
+                        let mid = scale_colour((lo + hi) / 2.0, lo, hi);
+                        entries.push((
+                            Mark::HatchOver(mid, true),
+                            "forward whirl (hatched the other way)".to_string(),
+                        ));
                     }
                 } else {
                     // The backward-whirl entry is always shown: it is where the scale stops.
@@ -433,6 +472,14 @@ impl Figure for GridFigure<'_> {
                     entries.push((
                         Mark::Hatch(true),
                         "forward whirl (not in scale)".to_string(),
+                    ));
+                }
+                if any_infinite {
+                    let (lo, hi) = scale.unwrap_or((0.0, 1.0));
+                    let words = m.infinite_label.unwrap_or("infinite");
+                    entries.push((
+                        Mark::Swatch(scale_colour(hi, lo, hi)),
+                        format!("{words} (drawn at the top of the scale)"),
                     ));
                 }
                 if any_unresolved {

@@ -51,8 +51,9 @@ pub enum Mark {
     Swatch(RGBColor),
     /// A hatched box (the other diagonal when true).
     Hatch(bool),
-    /// A box of a colour with white hatching over it: a whirl cell kept in the colour scale.
-    HatchOver(RGBColor),
+    /// A box of a colour with white hatching over it (the other diagonal when true): a whirl
+    /// cell kept in the colour scale.
+    HatchOver(RGBColor, bool),
     /// A failed-point cross.
     Failed,
     /// A solid line.
@@ -224,9 +225,9 @@ pub(crate) fn draw_mark<DB: DrawingBackend>(
             hatch(area, (bx0, by0), (bx1, by1), forward)?;
             area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], border))?;
         }
-        Mark::HatchOver(c) => {
+        Mark::HatchOver(c, forward) => {
             area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], c.filled()))?;
-            hatch_in(area, (bx0, by0), (bx1, by1), false, WHIRL_OVER)?;
+            hatch_in(area, (bx0, by0), (bx1, by1), forward, WHIRL_OVER)?;
             area.draw(&Rectangle::new([(bx0, by0), (bx1, by1)], border))?;
         }
         Mark::Failed => {

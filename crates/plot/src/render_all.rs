@@ -97,7 +97,8 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         )?;
     }
     // Only records made with the bearing analysis carry its results.
-    if wants("drops_to_failure") && rows.iter().any(|r| r.drops_to_failure.is_some()) {
+    // (A drop without damage has no drops to failure, but a pressure.)
+    if wants("drops_to_failure") && rows.iter().any(|r| r.peak_contact_pressure_pa.is_some()) {
         let fig = crate::bearing_life::drops_to_failure(&grid);
         write_both(&out_dir, "drops_to_failure", CHART_SIZE, &fig, &mut written)?;
     }

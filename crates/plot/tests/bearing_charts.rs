@@ -65,6 +65,28 @@ fn has(texts: &[String], text: &str) -> bool {
     texts.iter().any(|t| t == text)
 }
 
+/// The polylines of a chart's SVG drawn in the limit colour (rgb 214 39 40) that lie inside
+/// the map (left of the colour bar at x > 845 px, above the legend at y > 620 px), as
+/// their points.
+fn limit_lines_in_map(dir: &Path, stem: &str) -> Vec<Vec<(f64, f64)>> {
+    let svg = std::fs::read_to_string(dir.join("charts").join(format!("{stem}.svg"))).unwrap();
+    svg.lines()
+        .filter(|l| l.contains("<polyline") && l.contains("stroke=\"#D62728\""))
+        .filter_map(|l| {
+            let pts = l.split("points=\"").nth(1)?.split('"').next()?;
+            let points: Vec<(f64, f64)> = pts
+                .split_whitespace()
+                .filter_map(|p| {
+                    let (x, y) = p.split_once(',')?;
+                    Some((x.parse().ok()?, y.parse().ok()?))
+                })
+                .collect();
+            let inside = points.iter().all(|&(x, y)| x < 845.0 && y < 620.0);
+            inside.then_some(points)
+        })
+        .collect()
+}
+
 #[test]
 fn bearing_charts_are_drawn_from_records_with_the_analysis() {
     let dir = folder("bearing-charts", true, |speed, _| 1.0 + speed / 10000.0);
@@ -94,7 +116,7 @@ fn bearing_charts_are_drawn_from_records_with_the_analysis() {
     assert!(
         has(
             &drops,
-            "whirl (hatched): the damage of its first 5 turns only (the run stops there)"
+            "whirl (hatched): the damage of the run up to its 5th whirl turn (it stops there)"
         ),
         "the whirl cell's value is said to cover 5 turns: {drops:?}"
     );
@@ -116,7 +138,8 @@ fn bearing_charts_are_drawn_from_records_with_the_analysis() {
 
 #[test]
 fn the_static_limit_is_a_contour_where_the_pressure_crosses_it() {
-    // 3 to 5.4 GPa across the speeds: the 4.2 GPa line runs between 8000 and 12000 r/min.
+    // 3.3, 4.5 and 5.7 GPa at 4000, 8000 and 12000 r/min: the 4.2 GPa line crosses every
+    // friction row between the first two speeds, three quarters of the way to 8000 r/min.
     let dir = folder("bearing-limit", true, |speed, _| {
         3.0 + 0.3 * speed / 1000.0 - 0.9
     });
@@ -127,11 +150,31 @@ fn the_static_limit_is_a_contour_where_the_pressure_crosses_it() {
         "{pressure:?}"
     );
     assert!(!pressure.iter().any(|t| t.contains("not reached")));
-    // The limit is drawn in its own colour (LIMIT, rgb 214 39 40), dashed: more than the one
-    // legend mark and the colour bar's line.
-    let svg = std::fs::read_to_string(dir.join("charts/contact_pressure.svg")).unwrap();
-    let limit_paths = svg.matches("#D62728").count();
-    assert!(limit_paths >= 4, "{limit_paths} limit strokes");
+    // Dashed in the limit colour inside the map, running from the lowest friction row to
+    // the highest at one speed (a vertical line, x constant).
+    let lines = limit_lines_in_map(&dir, "contact_pressure");
+    assert!(lines.len() >= 4, "{} dashes in the map", lines.len());
+    let xs: Vec<f64> = lines.iter().flatten().map(|p| p.0).collect();
+    let (x_lo, x_hi) = xs
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, &x| (a.0.min(x), a.1.max(x)));
+    assert!(
+        x_hi - x_lo <= 1.0,
+        "the line is vertical: x from {x_lo} to {x_hi}"
+    );
+    let ys: Vec<f64> = lines.iter().flatten().map(|p| p.1).collect();
+    let (y_lo, y_hi) = ys
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, &y| (a.0.min(y), a.1.max(y)));
+    assert!(
+        y_hi - y_lo > 200.0,
+        "it spans the friction rows: y from {y_lo} to {y_hi}"
+    );
+    // Without a crossing no dash is in the map.
+    let low = folder("bearing-limit-low", true, |speed, _| 1.0 + speed / 10000.0);
+    render_all(&low).unwrap();
+    assert!(limit_lines_in_map(&low, "contact_pressure").is_empty());
+    let _ = std::fs::remove_dir_all(&low);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -152,6 +195,38 @@ fn a_scene_limit_other_than_iso_76_is_the_one_drawn() {
         "{pressure:?}"
     );
     assert!(!pressure.iter().any(|t| t.contains("4.2")), "{pressure:?}");
+    // 1 + speed / 10 000 crosses 2 GPa at 10 000 r/min: a line in the map.
+    assert!(!limit_lines_in_map(&dir, "contact_pressure").is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_drop_without_damage_has_an_infinite_life() {
+    // The records' null drops to failure beside a pressure: a loaded drop that did no
+    // damage (the core's infinite life, which JSON cannot hold).
+    let dir = folder("bearing-no-damage", true, |speed, _| 1.0 + speed / 10000.0);
+    let path = dir.join("points.jsonl");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    lines[0]["record"]["damage_per_drop"] = json!(0.0);
+    lines[0]["record"]["drops_to_failure"] = serde_json::Value::Null;
+    let out: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    std::fs::write(&path, out.join("\n")).unwrap();
+    let rows = load_points(&dir).unwrap();
+    assert_eq!(rows[0].drops_to_failure, None);
+    render_all(&dir).unwrap();
+    let drops = texts(&dir, "drops_to_failure");
+    assert!(
+        has(
+            &drops,
+            "no damage: infinite life (drawn at the top of the scale)"
+        ),
+        "{drops:?}"
+    );
+    assert!(!has(&drops, "no data"), "{drops:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -16,7 +16,7 @@ use whirlmap_results::point::{load_points, PointRow, PointStatus};
 
 /// Writes `dir/bearing.md` when the spec's scene has a bearing; returns its path.
 pub fn write(spec: &SweepSpec, dir: &Path) -> Result<Option<PathBuf>, SweepError> {
-    let Some(pair) = spec.scene.bearing.as_ref() else {
+    let Some(pair) = spec.base_scene().bearing_as_run() else {
         return Ok(None);
     };
     let rows = load_points(dir).map_err(|e| SweepError::Io {
@@ -24,7 +24,7 @@ pub fn write(spec: &SweepSpec, dir: &Path) -> Result<Option<PathBuf>, SweepError
         source: std::io::Error::other(e.to_string()),
     })?;
     let path = dir.join(BEARING_REPORT_FILE);
-    write_atomic(&path, report(spec, pair, &rows).as_bytes())?;
+    write_atomic(&path, report(spec, &pair, &rows).as_bytes())?;
     Ok(Some(path))
 }
 
@@ -43,29 +43,62 @@ fn at(r: &PointRow) -> String {
 
 /// The report's text.
 pub fn report(spec: &SweepSpec, pair: &BearingPair, rows: &[PointRow]) -> String {
-    let ok: Vec<&PointRow> = rows
+    let ran: Vec<&PointRow> = rows
         .iter()
-        .filter(|r| r.status == PointStatus::Ok && r.static_safety_factor.is_some())
+        .filter(|r| r.status == PointStatus::Ok)
         .collect();
-    let failed = rows.len() - ok.len();
+    let failed = rows.len() - ran.len();
+    // A drop that never loads the bearing has an infinite safety factor and no damage (the
+    // record's nulls): it is judged, and passes.
+    let ok: Vec<&PointRow> = ran
+        .iter()
+        .copied()
+        .filter(|r| r.static_safety_factor.is_some())
+        .collect();
+    let unloaded = ran.len() - ok.len();
     let limit_gpa = pair.static_limit_pressure_pa / 1e9;
     let mut t = String::new();
     let w = &mut t;
     let _ = writeln!(w, "# Touchdown-bearing survival: sweep `{}`\n", spec.name);
+    let mut counts = format!("{} ran", ran.len());
+    if failed > 0 {
+        counts.push_str(&format!(", {failed} failed (no bearing results)"));
+    }
+    if unloaded > 0 {
+        counts.push_str(&format!(
+            ", {unloaded} never loaded the bearing (no damage, an infinite margin)"
+        ));
+    }
+    let charts: Vec<String> = ["drops_to_failure", "contact_pressure"]
+        .iter()
+        .filter(|c| spec.charts.iter().any(|s| s == *c))
+        .map(|c| format!("`charts/{c}`"))
+        .collect();
     let _ = writeln!(
         w,
-        "{} drops of {} s each (model version {MODEL_VERSION}), {} with the bearing analysis's \
-         results{}. Every cell is in `summary.csv`; the charts are `charts/drops_to_failure` \
-         and `charts/contact_pressure`.\n",
+        "{} drops of {} s each (model version {MODEL_VERSION}): {counts}. Every drop is in \
+         `summary.csv`{}.\n",
         rows.len(),
         spec.duration_s,
-        ok.len(),
-        if failed > 0 {
-            format!(", {failed} without (failed drops)")
-        } else {
-            String::new()
+        match charts.as_slice() {
+            [] => String::new(),
+            cs => format!("; the charts are {}", cs.join(" and ")),
         }
     );
+    let varied: Vec<&str> = spec
+        .axes
+        .0
+        .iter()
+        .map(|a| a.name.as_str())
+        .filter(|n| n.starts_with("bearing."))
+        .collect();
+    if !varied.is_empty() {
+        let _ = writeln!(
+            w,
+            "The sweep varies {}: the bearing's data below are the base scene's.\n",
+            varied.join(", ")
+        );
+    }
 
     let _ = writeln!(w, "## Verdict\n");
     let over: Vec<&&PointRow> = ok
@@ -105,9 +138,8 @@ pub fn report(spec: &SweepSpec, pair: &BearingPair, rows: &[PointRow]) -> String
     if let Some((n, r)) = fewest(false) {
         let _ = writeln!(
             w,
-            "- **Fatigue (ISO 281, L10):** of the drops that run their full {} s, the fewest \
-             drops to failure are {n:.3e}, at {}.",
-            spec.duration_s,
+            "- **Fatigue (ISO 281, L10):** of the drops not stopped as whirl, the fewest drops \
+             to failure are {n:.3e}, at {}.",
             at(r)
         );
     }
@@ -188,7 +220,25 @@ pub fn report(spec: &SweepSpec, pair: &BearingPair, rows: &[PointRow]) -> String
             "paper, Table 4 (the dynamics' support law)",
         ),
     ];
-    for (q, v, src) in rows_table {
+    // A value the scene changed is the scene's, whatever the default's source.
+    let paper = BearingPair::default();
+    let changed = [
+        pair.rows != paper.rows,
+        pair.contact_angle_rad != paper.contact_angle_rad,
+        pair.ball_diameter_m != paper.ball_diameter_m,
+        pair.pitch_diameter_m != paper.pitch_diameter_m,
+        pair.balls_per_row != paper.balls_per_row,
+        pair.inner_conformity != paper.inner_conformity
+            || pair.outer_conformity != paper.outer_conformity,
+        pair.young_modulus_pa != paper.young_modulus_pa
+            || pair.poisson_ratio != paper.poisson_ratio,
+        pair.dynamic_rating_n != paper.dynamic_rating_n,
+        pair.static_rating_n != paper.static_rating_n,
+        pair.static_limit_pressure_pa != paper.static_limit_pressure_pa,
+        pair.lumped_stiffness_n_per_m1_5 != paper.lumped_stiffness_n_per_m1_5,
+    ];
+    for ((q, v, src), changed) in rows_table.into_iter().zip(changed) {
+        let src = if changed { "the scene" } else { src };
         let _ = writeln!(w, "| {q} | {v} | {src} |");
     }
     let _ = writeln!(w);
@@ -264,4 +314,81 @@ pub fn worst_lines(dir: &Path) -> Vec<String> {
         ));
     }
     lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::folder;
+
+    /// The committed life study's report is what its committed records give.
+    #[test]
+    fn the_report_of_committed_records_is_the_committed_report() {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/life");
+        let spec = folder::manifest_spec(&src).expect("a committed manifest");
+        let pair = spec.base_scene().bearing_as_run().expect("a bearing");
+        let rows = load_points(&src).unwrap();
+        let made = report(&spec, &pair, &rows);
+        let committed = std::fs::read_to_string(src.join(BEARING_REPORT_FILE)).unwrap();
+        assert!(
+            made == committed,
+            "results/life/bearing.md differs:\n{made}"
+        );
+    }
+
+    /// Failed drops, drops that never load the bearing and a changed bearing are each said.
+    #[test]
+    fn failures_unloaded_drops_and_scene_values_are_named() {
+        let mut spec = crate::spec::parse(
+            r#"{"name": "t", "scene": {"bearing": {"balls_per_row": 20}}, "duration_s": 0.1,
+                "axes": {"speed_rpm": {"from": 1000, "to": 2000, "steps": 3}}}"#,
+        )
+        .unwrap();
+        spec.charts = vec!["contact_pressure".to_string()];
+        let pair = spec.base_scene().bearing_as_run().unwrap();
+        let line = |i: u64, status: &str, rec: &str| {
+            let text = format!(
+                r#"{{"key": "k{i}", "index": {i}, "inputs": {{"speed_rpm": {}}}, "status": "{status}"{rec}}}"#,
+                1000 + 500 * i
+            );
+            PointRow::from(
+                serde_json::from_str::<whirlmap_results::point::PointLine>(&text).unwrap(),
+            )
+        };
+        let rows = vec![
+            line(
+                0,
+                "ok",
+                r#", "record": {"class": "pendulum", "peak_contact_pressure_pa": 1.4e9, "static_safety_factor": 3.0, "damage_per_drop": 1e-12, "drops_to_failure": 1e12}"#,
+            ),
+            line(
+                1,
+                "ok",
+                r#", "record": {"class": "pendulum", "peak_contact_pressure_pa": 0.0, "static_safety_factor": null, "damage_per_drop": 0.0, "drops_to_failure": null}"#,
+            ),
+            line(2, "failed", r#", "error": {"kind": "x", "message": "y"}"#),
+        ];
+        let text = report(&spec, &pair, &rows);
+        assert!(text.contains("3 drops of 0.1 s each"), "{text}");
+        assert!(
+            text.contains("2 ran, 1 failed (no bearing results), 1 never loaded the bearing"),
+            "{text}"
+        );
+        assert!(
+            text.contains("the charts are `charts/contact_pressure`."),
+            "{text}"
+        );
+        assert!(
+            text.contains("| balls per row | 20 | the scene |"),
+            "{text}"
+        );
+        assert!(
+            text.contains("| ball diameter | 5.5 mm | paper, Table 3 |"),
+            "{text}"
+        );
+        assert!(
+            text.contains("The lowest static safety factor is 3.00"),
+            "{text}"
+        );
+    }
 }

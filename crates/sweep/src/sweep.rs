@@ -865,7 +865,7 @@ mod tests {
 
     #[test]
     fn the_summary_of_committed_records_is_the_committed_summary() {
-        for name in ["paper", "paper-radial"] {
+        for name in ["paper", "paper-radial", "life"] {
             let src = Path::new(env!("CARGO_MANIFEST_DIR"))
                 .join("../../results")
                 .join(name);
