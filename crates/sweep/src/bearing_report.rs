@@ -148,8 +148,8 @@ pub fn report(spec: &SweepSpec, pair: &BearingPair, rows: &[PointRow]) -> String
         let _ = writeln!(
             w,
             "- **Whirl:** {whirls} of {} drops end in whirl. A whirl run is stopped once the \
-             whirl is decided, so its damage is that of the turns it ran: the fewest drops to \
-             failure among them, {n:.3e} at {}, count those turns only. In a rigid housing a \
+             whirl is decided, so its damage is that of the run up to there: the fewest drops \
+             to failure among them, {n:.3e} at {}, count that run only. In a rigid housing a \
              whirl goes on until the rotor is stopped, and every further turn adds damage.",
             ok.len(),
             at(r)
@@ -221,7 +221,13 @@ pub fn report(spec: &SweepSpec, pair: &BearingPair, rows: &[PointRow]) -> String
         ),
     ];
     // A value the scene changed is the scene's, whatever the default's source.
-    let paper = BearingPair::default();
+    // The paper's pair as a drop runs it (k2 from the paper scene's support law).
+    let paper = whirlmap_core::Scene {
+        bearing: Some(BearingPair::default()),
+        ..whirlmap_core::Scene::default()
+    }
+    .bearing_as_run()
+    .expect("a bearing");
     let changed = [
         pair.rows != paper.rows,
         pair.contact_angle_rad != paper.contact_angle_rad,
