@@ -507,10 +507,14 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
     }
     if let Some(b) = &r.bearing {
         outln!(
-            "  bearing               peak ball load {:.0} N, contact pressure {:.2} GPa (static safety factor {:.2} against 4.2 GPa)",
+            "  bearing               peak ball load {:.0} N, contact pressure {:.2} GPa (static safety factor {:.2} against {} GPa)",
             b.peak_ball_load_n,
             b.peak_contact_pressure_pa / 1e9,
-            b.static_safety_factor
+            b.static_safety_factor,
+            scene
+                .bearing
+                .as_ref()
+                .map_or(4.2, |p| p.static_limit_pressure_pa / 1e9)
         );
         outln!(
             "  fatigue               damage {:.3e} per drop, {:.3e} drops to failure (L10; {})",
