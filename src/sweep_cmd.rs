@@ -90,7 +90,7 @@ pub fn run(a: &SweepArgs) -> CmdResult {
         }
         outln!("  output           {}", outcome.out_dir.display());
         if spec.scene.bearing.is_some() {
-            for line in whirlmap_sweep::bearing_report::worst_lines(&outcome.out_dir) {
+            for line in whirlmap_sweep::results::bearing_report::worst_lines(&outcome.out_dir) {
                 outln!("  {line}");
             }
         }

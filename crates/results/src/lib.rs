@@ -7,6 +7,8 @@
 //! - [`record`], [`point`]: the record of one drop and the lines of `points.jsonl`, written
 //!   and read back through the same types, byte for byte.
 //! - [`summary`]: the rows of `summary.csv`, made from the lines of `points.jsonl`.
+//! - [`bearing_report`]: `bearing.md`, the touchdown-bearing survival report, made from the
+//!   lines of `points.jsonl`.
 //! - [`critical`]: the rows of `critical.json` and `critical.csv`.
 //! - [`orbit`]: the recorded orbits of `orbits/`.
 //! - [`contours`]: an ensemble's `contours.json`.
@@ -25,6 +27,7 @@
 
 pub mod adaptive;
 pub mod atomic;
+pub mod bearing_report;
 pub mod contours;
 pub mod critical;
 pub mod ensemble;

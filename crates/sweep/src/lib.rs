@@ -27,7 +27,6 @@ pub use whirlmap_results as results;
 
 pub mod accuracy;
 pub mod adaptive;
-pub mod bearing_report;
 pub mod build_info;
 pub mod classify;
 pub mod compare;

@@ -606,7 +606,7 @@ pub fn merge(
     for f in [POINTS_FILE, TIMINGS_FILE, SUMMARY_FILE] {
         out.record(f)?;
     }
-    if crate::bearing_report::write(&spec, out_dir)?.is_some() {
+    if crate::sweep::write_bearing_report(&spec, out_dir)? {
         out.record(crate::sweep::BEARING_REPORT_FILE)?;
     }
     record.counts = Some(crate::sweep::Counts {

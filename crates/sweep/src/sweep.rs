@@ -352,6 +352,30 @@ fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
     Ok(map)
 }
 
+/// Writes `out/bearing.md` from the records ([`whirlmap_results::bearing_report`]) when the
+/// spec's scene turns the bearing analysis on; returns whether it did.
+pub(crate) fn write_bearing_report(spec: &SweepSpec, out: &Path) -> Result<bool, SweepError> {
+    use whirlmap_results::bearing_report::{report, ReportSpec};
+    let Some(pair) = spec.base_scene().bearing_as_run() else {
+        return Ok(false);
+    };
+    let rows = whirlmap_results::point::load_points(out).map_err(|e| SweepError::Io {
+        path: out.join(POINTS_FILE),
+        source: std::io::Error::other(e.to_string()),
+    })?;
+    let about = ReportSpec {
+        name: spec.name.clone(),
+        duration_s: spec.duration_s,
+        charts: spec.charts.clone(),
+        axes: spec.axes.0.iter().map(|a| a.name.clone()).collect(),
+    };
+    folder::write_atomic(
+        &out.join(BEARING_REPORT_FILE),
+        report(&about, &pair, &rows).as_bytes(),
+    )?;
+    Ok(true)
+}
+
 /// Reads `points.jsonl` (one line per grid point in `indices`' order) and writes
 /// `summary.csv` from it, line by line. Returns (ok, failed, class counts).
 pub(crate) fn write_summary(
@@ -837,7 +861,7 @@ pub fn run_grid(
     run.folder.record(TIMINGS_FILE)?;
     run.folder.record(SUMMARY_FILE)?;
     // A shard holds part of the grid: its merge writes the report.
-    if shard.is_none() && crate::bearing_report::write(spec, &out)?.is_some() {
+    if shard.is_none() && write_bearing_report(spec, &out)? {
         run.folder.record(BEARING_REPORT_FILE)?;
     }
     run.record.counts = Some(Counts {
@@ -881,6 +905,21 @@ mod tests {
             assert!(made == committed, "{name}: summary.csv differs");
             std::fs::remove_dir_all(&dir).ok();
         }
+    }
+
+    /// The committed life study's report is what its committed records give.
+    #[test]
+    fn the_report_of_committed_records_is_the_committed_report() {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/life");
+        let spec = folder::manifest_spec(&src).expect("a committed manifest");
+        let dir = std::env::temp_dir().join(format!("whirlmap-report-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::copy(src.join(POINTS_FILE), dir.join(POINTS_FILE)).unwrap();
+        assert!(write_bearing_report(&spec, &dir).unwrap());
+        let made = std::fs::read(dir.join(BEARING_REPORT_FILE)).unwrap();
+        let committed = std::fs::read(src.join(BEARING_REPORT_FILE)).unwrap();
+        assert!(made == committed, "results/life/bearing.md differs");
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     fn point(scene: Scene) -> Point {

@@ -1,31 +1,27 @@
-//! `bearing.md`: the touchdown-bearing survival report of a sweep whose scene turns the
-//! bearing analysis on, written from `points.jsonl` beside `summary.csv` (so a merge of
-//! shards writes the same bytes). It reads as the bearing section of a qualification report:
-//! the verdict against the static limit and in fatigue, the bearing's data, the worst drops
-//! and the assumptions behind every number.
+//! The touchdown-bearing survival report of a sweep whose scene turns the bearing analysis
+//! on ([`BEARING_REPORT_FILE`], `bearing.md`), made from its records alone, so that a whole
+//! run and a merge of shards write the same bytes. It reads as the bearing section of a
+//! qualification report: the verdict against the static limit and in fatigue, the bearing's
+//! data, the worst drops and the assumptions behind every number.
 
-use crate::folder::write_atomic;
-use crate::spec::SweepSpec;
-use crate::sweep::SweepError;
+use crate::files::BEARING_REPORT_FILE;
+use crate::point::{load_points, PointRow, PointStatus};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use whirlmap_core::bearing::{assumptions, BearingPair};
-use whirlmap_core::MODEL_VERSION;
-use whirlmap_results::files::BEARING_REPORT_FILE;
-use whirlmap_results::point::{load_points, PointRow, PointStatus};
+use whirlmap_core::{Scene, MODEL_VERSION};
 
-/// Writes `dir/bearing.md` when the spec's scene has a bearing; returns its path.
-pub fn write(spec: &SweepSpec, dir: &Path) -> Result<Option<PathBuf>, SweepError> {
-    let Some(pair) = spec.base_scene().bearing_as_run() else {
-        return Ok(None);
-    };
-    let rows = load_points(dir).map_err(|e| SweepError::Io {
-        path: dir.join(whirlmap_results::files::POINTS_FILE),
-        source: std::io::Error::other(e.to_string()),
-    })?;
-    let path = dir.join(BEARING_REPORT_FILE);
-    write_atomic(&path, report(spec, &pair, &rows).as_bytes())?;
-    Ok(Some(path))
+/// What the report needs of a sweep's spec.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReportSpec {
+    /// The sweep's name.
+    pub name: String,
+    /// Simulated time per drop (s).
+    pub duration_s: f64,
+    /// The charts the spec lists (the report names the bearing charts among them).
+    pub charts: Vec<String>,
+    /// The names of the sweep's axes (an axis over `bearing.*` is said).
+    pub axes: Vec<String>,
 }
 
 /// Where a drop is, and what a stopped whirl's numbers cover.
@@ -42,7 +38,7 @@ fn at(r: &PointRow) -> String {
 }
 
 /// The report's text.
-pub fn report(spec: &SweepSpec, pair: &BearingPair, rows: &[PointRow]) -> String {
+pub fn report(spec: &ReportSpec, pair: &BearingPair, rows: &[PointRow]) -> String {
     let ran: Vec<&PointRow> = rows
         .iter()
         .filter(|r| r.status == PointStatus::Ok)
@@ -87,9 +83,8 @@ pub fn report(spec: &SweepSpec, pair: &BearingPair, rows: &[PointRow]) -> String
     );
     let varied: Vec<&str> = spec
         .axes
-        .0
         .iter()
-        .map(|a| a.name.as_str())
+        .map(String::as_str)
         .filter(|n| n.starts_with("bearing."))
         .collect();
     if !varied.is_empty() {
@@ -222,9 +217,9 @@ pub fn report(spec: &SweepSpec, pair: &BearingPair, rows: &[PointRow]) -> String
     ];
     // A value the scene changed is the scene's, whatever the default's source.
     // The paper's pair as a drop runs it (k2 from the paper scene's support law).
-    let paper = whirlmap_core::Scene {
+    let paper = Scene {
         bearing: Some(BearingPair::default()),
-        ..whirlmap_core::Scene::default()
+        ..Scene::default()
     }
     .bearing_as_run()
     .expect("a bearing");
@@ -325,41 +320,31 @@ pub fn worst_lines(dir: &Path) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::folder;
-
-    /// The committed life study's report is what its committed records give.
-    #[test]
-    fn the_report_of_committed_records_is_the_committed_report() {
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/life");
-        let spec = folder::manifest_spec(&src).expect("a committed manifest");
-        let pair = spec.base_scene().bearing_as_run().expect("a bearing");
-        let rows = load_points(&src).unwrap();
-        let made = report(&spec, &pair, &rows);
-        let committed = std::fs::read_to_string(src.join(BEARING_REPORT_FILE)).unwrap();
-        assert!(
-            made == committed,
-            "results/life/bearing.md differs:\n{made}"
-        );
-    }
 
     /// Failed drops, drops that never load the bearing and a changed bearing are each said.
     #[test]
     fn failures_unloaded_drops_and_scene_values_are_named() {
-        let mut spec = crate::spec::parse(
-            r#"{"name": "t", "scene": {"bearing": {"balls_per_row": 20}}, "duration_s": 0.1,
-                "axes": {"speed_rpm": {"from": 1000, "to": 2000, "steps": 3}}}"#,
-        )
+        let spec = ReportSpec {
+            name: "t".to_string(),
+            duration_s: 0.1,
+            charts: vec!["contact_pressure".to_string()],
+            axes: vec!["speed_rpm".to_string()],
+        };
+        let pair = Scene {
+            bearing: Some(BearingPair {
+                balls_per_row: 20,
+                ..BearingPair::default()
+            }),
+            ..Scene::default()
+        }
+        .bearing_as_run()
         .unwrap();
-        spec.charts = vec!["contact_pressure".to_string()];
-        let pair = spec.base_scene().bearing_as_run().unwrap();
         let line = |i: u64, status: &str, rec: &str| {
             let text = format!(
                 r#"{{"key": "k{i}", "index": {i}, "inputs": {{"speed_rpm": {}}}, "status": "{status}"{rec}}}"#,
                 1000 + 500 * i
             );
-            PointRow::from(
-                serde_json::from_str::<whirlmap_results::point::PointLine>(&text).unwrap(),
-            )
+            PointRow::from(serde_json::from_str::<crate::point::PointLine>(&text).unwrap())
         };
         let rows = vec![
             line(
@@ -396,5 +381,11 @@ mod tests {
             text.contains("The lowest static safety factor is 3.00"),
             "{text}"
         );
+        // The axes: one over the bearing is said.
+        let varied = ReportSpec {
+            axes: vec!["bearing.balls_per_row".to_string()],
+            ..spec
+        };
+        assert!(report(&varied, &pair, &rows).contains("The sweep varies bearing.balls_per_row"));
     }
 }
