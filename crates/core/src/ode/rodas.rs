@@ -23,10 +23,10 @@
 //! step's ends.
 
 use super::control::{StepCore, StepLaw};
-use super::rosw::Lu;
+use super::rosw::{rosenbrock_step, Lu, Rosenbrock};
 use super::step::{Dense, StepControl};
 use super::stepper::Stepper;
-use super::system::{OdeSystem, StiffJacobian};
+use super::system::OdeSystem;
 use crate::error::SolveError;
 
 const GAMMA: f64 = 0.25;
@@ -201,37 +201,21 @@ impl<const N: usize> Stepper<N> for Rodas4<N> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError> {
-        self.lu.j = sys
-            .stiff_jacobian(t, y)
-            .unwrap_or_else(|| StiffJacobian::over(&[]));
-        self.core.stats.jacobians += 1;
-        let (lu, f0) = (&mut self.lu, &self.f0);
-        let (y1, h) = self.core.control(&LAW, t, h_cap, |core, h| {
-            core.stats.factorizations += 1;
-            if lu.factor(h * GAMMA) {
-                Self::attempt(core, lu, f0, sys, t, y, h)
-            } else {
-                ([f64::NAN; N], f64::NAN)
-            }
-        })?;
-        let mut f1 = [0.0; N];
-        sys.rhs(t + h, &y1, &mut f1);
-        self.core.stats.rhs_evals += 1;
-        // Cubic Hermite, as ROS34PW2 writes it.
-        let d = &mut self.core.dense;
-        let r = &mut d.r;
-        for i in 0..N {
-            let ydiff = y1[i] - y[i];
-            let bspl = h * self.f0[i] - ydiff;
-            r[0][i] = y[i];
-            r[1][i] = ydiff;
-            r[2][i] = bspl;
-            r[3][i] = ydiff - h * f1[i] - bspl;
-        }
-        (d.t0, d.h, d.t_end, d.terms, d.y1) = (t, h, t + h, 5, y1);
-        self.f0 = f1;
-        self.core.stats.steps += 1;
-        Ok(&self.core.dense)
+        let method = Rosenbrock {
+            law: &LAW,
+            gamma: GAMMA,
+            attempt: Self::attempt::<S>,
+        };
+        rosenbrock_step(
+            &mut self.core,
+            &mut self.lu,
+            &mut self.f0,
+            &method,
+            sys,
+            t,
+            y,
+            h_cap,
+        )
     }
 
     fn core(&self) -> &StepCore<N> {

@@ -398,6 +398,70 @@ impl<const N: usize> Ros34pw2<N> {
     }
 }
 
+/// What differs between the Rosenbrock methods sharing [`rosenbrock_step`]: the step law, the
+/// diagonal `gamma` of the matrix `I - h gamma J`, and the attempt.
+pub(super) struct Rosenbrock<'a, A> {
+    /// The step-size law (orders, safety, growth limits).
+    pub(super) law: &'a StepLaw,
+    /// The method's diagonal coefficient.
+    pub(super) gamma: f64,
+    /// One attempt at a step of size `h`: `(core, lu, f0, sys, t, y, h)` to the new state and
+    /// its scaled error (a method's `attempt`, a function item, so it inlines).
+    pub(super) attempt: A,
+}
+
+/// One accepted step of a Rosenbrock method on the stiff Jacobian (ROS34PW2, RODAS4): the
+/// Jacobian once per step, a factorisation per attempt, the step control, then the cubic
+/// Hermite dense output in DOPRI5's nested form with the 4th coefficient zero, written in
+/// place (row 4 stays zero from `StepCore::new`, rows 5-7 unused with `terms` 5). `f0` is
+/// the derivative at the step's start, and becomes the one at its end.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn rosenbrock_step<'c, const N: usize, S, A>(
+    core: &'c mut StepCore<N>,
+    lu: &mut Lu,
+    f0: &mut [f64; N],
+    method: &Rosenbrock<'_, A>,
+    sys: &S,
+    t: f64,
+    y: &[f64; N],
+    h_cap: f64,
+) -> Result<&'c Dense<N>, SolveError>
+where
+    S: OdeSystem<N>,
+    A: Fn(&mut StepCore<N>, &Lu, &[f64; N], &S, f64, &[f64; N], f64) -> ([f64; N], f64),
+{
+    lu.j = sys
+        .stiff_jacobian(t, y)
+        .unwrap_or_else(|| StiffJacobian::over(&[]));
+    core.stats.jacobians += 1;
+    let start = *f0;
+    let (y1, h) = core.control(method.law, t, h_cap, |core, h| {
+        core.stats.factorizations += 1;
+        if lu.factor(h * method.gamma) {
+            (method.attempt)(core, lu, &start, sys, t, y, h)
+        } else {
+            ([f64::NAN; N], f64::NAN)
+        }
+    })?;
+    let mut f1 = [0.0; N];
+    sys.rhs(t + h, &y1, &mut f1);
+    core.stats.rhs_evals += 1;
+    let d = &mut core.dense;
+    let r = &mut d.r;
+    for i in 0..N {
+        let ydiff = y1[i] - y[i];
+        let bspl = h * start[i] - ydiff;
+        r[0][i] = y[i];
+        r[1][i] = ydiff;
+        r[2][i] = bspl;
+        r[3][i] = ydiff - h * f1[i] - bspl;
+    }
+    (d.t0, d.h, d.t_end, d.terms, d.y1) = (t, h, t + h, 5, y1);
+    *f0 = f1;
+    core.stats.steps += 1;
+    Ok(&core.dense)
+}
+
 impl<const N: usize> Stepper<N> for Ros34pw2<N> {
     fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
         sys.rhs(t, y, &mut self.f0);
@@ -411,38 +475,21 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError> {
-        self.lu.j = sys
-            .stiff_jacobian(t, y)
-            .unwrap_or_else(|| StiffJacobian::over(&[]));
-        self.core.stats.jacobians += 1;
-        let (lu, f0) = (&mut self.lu, &self.f0);
-        let (y1, h) = self.core.control(&LAW, t, h_cap, |core, h| {
-            core.stats.factorizations += 1;
-            if lu.factor(h * GAMMA) {
-                Self::attempt(core, lu, f0, sys, t, y, h)
-            } else {
-                ([f64::NAN; N], f64::NAN)
-            }
-        })?;
-        let mut f1 = [0.0; N];
-        sys.rhs(t + h, &y1, &mut f1);
-        self.core.stats.rhs_evals += 1;
-        // Cubic Hermite in DOPRI5's nested form with the 4th coefficient zero, written in
-        // place (row 4 stays zero from `StepCore::new`, rows 5-7 unused with `terms` 5).
-        let d = &mut self.core.dense;
-        let r = &mut d.r;
-        for i in 0..N {
-            let ydiff = y1[i] - y[i];
-            let bspl = h * self.f0[i] - ydiff;
-            r[0][i] = y[i];
-            r[1][i] = ydiff;
-            r[2][i] = bspl;
-            r[3][i] = ydiff - h * f1[i] - bspl;
-        }
-        (d.t0, d.h, d.t_end, d.terms, d.y1) = (t, h, t + h, 5, y1);
-        self.f0 = f1;
-        self.core.stats.steps += 1;
-        Ok(&self.core.dense)
+        let method = Rosenbrock {
+            law: &LAW,
+            gamma: GAMMA,
+            attempt: Self::attempt::<S>,
+        };
+        rosenbrock_step(
+            &mut self.core,
+            &mut self.lu,
+            &mut self.f0,
+            &method,
+            sys,
+            t,
+            y,
+            h_cap,
+        )
     }
 
     fn core(&self) -> &StepCore<N> {
