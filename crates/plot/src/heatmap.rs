@@ -145,7 +145,7 @@ pub(crate) struct GridFigure<'a> {
     pub(crate) mode: GridMode<'a>,
     pub(crate) bar_label: &'static str,
     /// The legend's words for whirl cells kept in the scale (what their value means), when
-    /// the default ("backward whirl (in scale)") says too little.
+    /// the default ("whirl (in scale)") says too little.
     pub(crate) whirl_label: Option<String>,
     /// A limit to draw (metric modes only).
     pub(crate) limit: Option<Limit>,
