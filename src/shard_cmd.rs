@@ -2,7 +2,7 @@
 //! `whirlmap_sweep::shard`). Exit codes as for a whole sweep: 0 every owned point ok, 1 some
 //! point failed (records still written), 2 bad input, 4 an output could not be written.
 
-use crate::sweep_cmd::SweepArgs;
+use crate::sweep_cmd::{counts, SweepArgs};
 use crate::{CmdResult, Done, Failure};
 use std::path::PathBuf;
 use whirlmap_sweep::pipeline::{self, Stages};
@@ -37,17 +37,10 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> CmdRe
         .map(|o| (o.outcome, o.extras.critical))
         .map_err(|e| Failure::coded(e.exit_code(), e))?;
     outln!(
-        "sweep {} shard {}: {} points, {} ok, {} failed{}",
+        "sweep {} shard {}: {}",
         spec.name,
         shard.label(),
-        outcome.points,
-        outcome.ok,
-        outcome.failed,
-        if outcome.skipped > 0 {
-            format!(" ({} resumed)", outcome.skipped)
-        } else {
-            String::new()
-        }
+        counts(&outcome)
     );
     if let Some(p) = critical {
         outln!("  critical speeds  {}", p.display());

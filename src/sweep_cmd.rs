@@ -51,6 +51,20 @@ pub struct SweepArgs {
     shards: Option<usize>,
 }
 
+/// "N points, N ok, N failed (N resumed)": a run's counts, as the sweep and shard
+/// commands print them.
+pub(crate) fn counts(outcome: &SweepOutcome) -> String {
+    let resumed = if outcome.skipped > 0 {
+        format!(" ({} resumed)", outcome.skipped)
+    } else {
+        String::new()
+    };
+    format!(
+        "{} points, {} ok, {} failed{resumed}",
+        outcome.points, outcome.ok, outcome.failed
+    )
+}
+
 /// Runs the subcommand: `Flagged` (exit 1) when some points failed.
 pub fn run(a: &SweepArgs) -> CmdResult {
     let spec = spec::read(&a.file).map_err(|e| Failure::coded(2, e))?;
@@ -73,18 +87,7 @@ pub fn run(a: &SweepArgs) -> CmdResult {
         },
     };
     let on_grid = |outcome: &SweepOutcome| {
-        outln!(
-            "sweep {}: {} points, {} ok, {} failed{}",
-            spec.name,
-            outcome.points,
-            outcome.ok,
-            outcome.failed,
-            if outcome.skipped > 0 {
-                format!(" ({} resumed)", outcome.skipped)
-            } else {
-                String::new()
-            }
-        );
+        outln!("sweep {}: {}", spec.name, counts(outcome));
         for (class, n) in &outcome.classes {
             outln!("  {class:<16} {n}");
         }

@@ -15,7 +15,28 @@ pub fn progress_line(line: &str) {
 }
 
 /// How often a plain progress line is written.
-const PLAIN_EVERY: Duration = Duration::from_secs(5);
+pub(crate) const PLAIN_EVERY: Duration = Duration::from_secs(5);
+
+/// The clock of plain progress lines, shared by the worker threads: a line is due at most
+/// once every [`PLAIN_EVERY`].
+pub(crate) struct PlainClock(Mutex<Instant>);
+
+impl PlainClock {
+    /// A clock whose first line is due [`PLAIN_EVERY`] from now.
+    pub(crate) fn new() -> Self {
+        Self(Mutex::new(Instant::now()))
+    }
+
+    /// Whether a line is due now; if so, the next one is due [`PLAIN_EVERY`] later.
+    pub(crate) fn due(&self) -> bool {
+        let mut last = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let due = last.elapsed() >= PLAIN_EVERY;
+        if due {
+            *last = Instant::now();
+        }
+        due
+    }
+}
 
 /// Counts finished drops of one phase and reports them; shared by the worker threads.
 pub struct Ticker {
@@ -26,7 +47,7 @@ pub struct Ticker {
     bar: Option<ProgressBar>,
     plain: bool,
     start: Instant,
-    last_line: Mutex<Instant>,
+    clock: PlainClock,
 }
 
 impl Ticker {
@@ -52,7 +73,7 @@ impl Ticker {
             bar,
             plain: on && !tty,
             start: Instant::now(),
-            last_line: Mutex::new(Instant::now()),
+            clock: PlainClock::new(),
         }
     }
 
@@ -78,12 +99,8 @@ impl Ticker {
         if let Some(b) = &self.bar {
             b.inc(1);
         }
-        if self.plain {
-            let mut last = self.last_line.lock().unwrap_or_else(|e| e.into_inner());
-            if last.elapsed() >= PLAIN_EVERY {
-                *last = Instant::now();
-                progress_line(&self.line());
-            }
+        if self.plain && self.clock.due() {
+            progress_line(&self.line());
         }
     }
 

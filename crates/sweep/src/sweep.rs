@@ -49,7 +49,6 @@ use std::fs::{File, OpenOptions};
 use std::io::{BufRead, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use thiserror::Error;
 use whirlmap_core::scene::fnv1a64;
@@ -219,12 +218,11 @@ struct Progress {
     failed: AtomicUsize,
     start_done: usize,
     start: Instant,
-    last_line: Mutex<Instant>,
+    clock: PlainClock,
 }
 
-const PLAIN_EVERY: Duration = Duration::from_secs(5);
-
 pub use crate::progress::progress_line;
+use crate::progress::{PlainClock, PLAIN_EVERY};
 
 impl Progress {
     fn new(name: &str, total: usize, already: usize, mode: ProgressMode) -> Self {
@@ -260,7 +258,7 @@ impl Progress {
             failed: AtomicUsize::new(0),
             start_done: already,
             start: Instant::now(),
-            last_line: Mutex::new(Instant::now()),
+            clock: PlainClock::new(),
         }
     }
 
@@ -272,12 +270,8 @@ impl Progress {
         if let Some(b) = &self.bar {
             b.inc(1);
         }
-        if self.plain {
-            let mut last = self.last_line.lock().unwrap_or_else(|e| e.into_inner());
-            if last.elapsed() >= PLAIN_EVERY {
-                *last = Instant::now();
-                progress_line(&self.line());
-            }
+        if self.plain && self.clock.due() {
+            progress_line(&self.line());
         }
     }
 
