@@ -395,3 +395,82 @@ fn rodas4_loses_its_order_with_a_wrong_jacobian() {
         "observed order {order:.2} ({e1:e} -> {e2:e} -> {e3:e})"
     );
 }
+
+/// y0' = -y0 with its exact Jacobian, and the accumulator y1' = y0^2, which no right-hand side
+/// reads: y0 = exp(-t), y1 = (1 - exp(-2 t)) / 2. `quadrature_row` hands the stepper the
+/// accumulator's row `d y1' / d y0 = 2 y0` ([`StiffJacobian::quad`]).
+struct Accumulator {
+    quadrature_row: bool,
+}
+impl OdeSystem<2> for Accumulator {
+    type Guard = NoGuard;
+    fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+        dy[0] = -y[0];
+        dy[1] = y[0] * y[0];
+    }
+    fn stiff_jacobian(&self, _t: f64, y: &[f64; 2]) -> Option<StiffJacobian> {
+        let mut s = StiffJacobian::over(&[0]);
+        s.jac[(0, 0)] = -1.0;
+        if self.quadrature_row {
+            s.quad_idx[0] = 1;
+            s.quad_len = 1;
+            s.quad[(0, 0)] = 2.0 * y[0];
+        }
+        Some(s)
+    }
+}
+
+/// RODAS4 on an accumulator: without its row in the matrix the accumulator converges at a low
+/// order (the matrix is not the Jacobian there); with it, at the method's order 4. ROS34PW2, a
+/// W-method, keeps its order 3 without the row.
+#[test]
+fn an_accumulators_row_gives_rodas4_its_order() {
+    let t_end: f64 = 2.0;
+    let exact = 0.5 * (1.0 - (-2.0 * t_end).exp());
+    let ctl = |n: usize| StepControl {
+        rtol: 1.0,
+        atol: [1.0; 2],
+        h_min: 0.0,
+        max_attempts: u64::MAX,
+        fixed_step: Some(t_end / n as f64),
+    };
+    let err_at = |quadrature_row: bool, n: usize, rodas: bool| {
+        let sys = Accumulator { quadrature_row };
+        let (mut t, mut y) = (0.0, [1.0, 0.0]);
+        let stop = if rodas {
+            integrate(
+                &sys,
+                &mut Rodas4::new(ctl(n)),
+                &mut t,
+                &mut y,
+                t_end,
+                &mut NoObserver,
+            )
+        } else {
+            integrate(
+                &sys,
+                &mut Ros34pw2::new(ctl(n)),
+                &mut t,
+                &mut y,
+                t_end,
+                &mut NoObserver,
+            )
+        };
+        assert!(matches!(stop, Ok(Stop::EndTime)));
+        (y[1] - exact).abs()
+    };
+    let order = |row: bool, rodas: bool| (err_at(row, 40, rodas) / err_at(row, 80, rodas)).log2();
+    let (with, without, w_method) = (order(true, true), order(false, true), order(false, false));
+    println!(
+        "accumulator: RODAS4 order {with:.2} with its row, {without:.2} without; ROS34PW2 {w_method:.2}"
+    );
+    assert!(
+        (3.7..4.4).contains(&with),
+        "RODAS4 with the row: order {with:.2}"
+    );
+    assert!(without < 3.3, "RODAS4 without the row: order {without:.2}");
+    assert!(
+        (2.7..3.4).contains(&w_method),
+        "ROS34PW2 without the row: order {w_method:.2}"
+    );
+}

@@ -46,6 +46,24 @@ impl Palmgren {
         f1 * p * self.dm_mm * 1e-3
     }
 
+    /// The slopes of [`Palmgren::torque_n_m`]: `(dM/d omega` (N m s), `dM/d load` (m)`)`.
+    /// Eq. 12's M_0 grows as `|omega|^(2/3)` above its low-speed constant (flat below it);
+    /// eq. 13's M_1 as `load^1.33`.
+    pub fn torque_slopes(&self, omega_rad_s: f64, load_n: f64) -> (f64, f64) {
+        let x = self.nu0_mm2_s * omega_rad_s.abs() * RAD_S_TO_RPM;
+        let d_omega = if omega_rad_s != 0.0 && x.powf(2.0 / 3.0) > 160.0 {
+            (2.0 / 3.0) * self.viscous_torque_n_m(omega_rad_s) / omega_rad_s
+        } else {
+            0.0
+        };
+        let d_load = if load_n > 0.0 {
+            1.33 * self.load_torque_n_m(load_n) / load_n
+        } else {
+            0.0
+        };
+        (d_omega, d_load)
+    }
+
     /// Total drag torque magnitude M = M_0 + M_1 (N m), eq. 11.
     #[inline]
     pub fn torque_n_m(&self, omega_rad_s: f64, load_n: f64) -> f64 {
@@ -68,6 +86,17 @@ pub fn direction(omega_rad_s: f64, omega_eps_rad_s: f64) -> f64 {
     } else {
         x.tanh()
     }
+}
+
+/// [`direction`] and its slope in `omega_rad_s` (s/rad).
+pub fn direction_and_slope(omega_rad_s: f64, omega_eps_rad_s: f64) -> (f64, f64) {
+    let d = direction(omega_rad_s, omega_eps_rad_s);
+    let slope = if d.abs() < 1.0 {
+        (1.0 - d * d) / omega_eps_rad_s
+    } else {
+        0.0
+    };
+    (d, slope)
 }
 
 #[cfg(test)]

@@ -1,10 +1,11 @@
-//! The stiff part of the model's Jacobian for the linearly implicit stepper (ROS34PW2): the
-//! derivatives of eq. 7's two Hertz contacts and of the friction that follows them (eq. 8),
-//! over the translations, their rates and the two spins.
+//! The stiff part of the model's Jacobian for the linearly implicit steppers (ROS34PW2,
+//! RODAS4): the derivatives of eq. 7's two Hertz contacts and of the friction that follows
+//! them (eq. 8), over the translations, their rates and the two spins; and the rows of the
+//! accumulators (energy integrals, angles) over the same components.
 
 use super::friction::FrictionSlopes;
 use super::state::{ix, N};
-use super::{hertz, DropSystem};
+use super::{drag, hertz, DropSystem};
 use crate::ode::StiffJacobian;
 use nalgebra::{Matrix2, Vector2};
 
@@ -14,7 +15,10 @@ impl DropSystem {
     /// normal), the friction that follows them (eq. 8; the regularised law's slope in the
     /// slip velocity too), over the translations, their rates and the two spins. Left out,
     /// because they are not stiff: gravity, the unbalance terms, Palmgren drag, and the
-    /// sticking constraint's dependence on the state.
+    /// sticking constraint's dependence on the state. Its quadrature rows (for RODAS4, which
+    /// keeps its order only with them) are the energy integrals' powers (eq. 17's H_s, the
+    /// dampers' power, the drag's M |omega_b| with eq. 13's load slope) and the two angles
+    /// (theta' = omega).
     #[inline]
     pub(super) fn stiff_jacobian_at(&self, y: &[f64; N]) -> StiffJacobian {
         use ix::*;
@@ -29,6 +33,18 @@ impl DropSystem {
         let mut sj = StiffJacobian::over(&[XR, YR, XB, YB, VXR, VYR, VXB, VYB, WR, WB]);
         // The four positions' rows are exactly q' = v (eqs. 1-6): the stepper eliminates them.
         sj.kinematic = 4;
+        // The energy integrals' rows (their powers over the same components), then the two
+        // angles' (theta' = omega; without unbalance no force reads an angle).
+        const FRIC: usize = 0;
+        const DAMP: usize = 1;
+        const DRAG: usize = 2;
+        sj.quad_idx[..5].copy_from_slice(&[E_FRIC, E_DAMP, E_DRAG, TR, TB]);
+        sj.quad_len = 5;
+        sj.quad[(3, SR)] = 1.0;
+        sj.quad[(4, SB)] = 1.0;
+        // The gradient of the load the drag sees (the support force) over the rotor's and
+        // the race's positions and velocities.
+        let mut dload = [Vector2::zeros(); 4];
         let j = &mut sj.jac;
         j.fixed_view_mut::<4, 4>(QR, VR).fill_with_identity();
         let f = self.forces(y);
@@ -41,7 +57,8 @@ impl DropSystem {
             let p = Matrix2::identity() - n * n.transpose();
             let rp = quarter * p;
             let pw = p * w;
-            let (kd, c) = match &self.series {
+            // kd: dF_n/dd along n; c: the damper; dc: its slope in the penetration.
+            let (kd, c, dc) = match &self.series {
                 Some(ss) => {
                     // Series springs: dF/dd = F / (a/e1 + b/e2); the split damper's weight
                     // w = (a/e1) / (a/e1 + b/e2) moves with d too (its slope times delta_dot
@@ -52,15 +69,15 @@ impl DropSystem {
                     let denom = a * pp + b * q;
                     let wc = sp.w_contact;
                     let c = self.c1 * wc * wc + self.c2 * (1.0 - wc) * (1.0 - wc);
-                    let kd = if denom > 0.0 && fa > 0.0 {
+                    let (kd, dc) = if denom > 0.0 && fa > 0.0 {
                         let k = fa / denom;
                         let dw = pp * q * a * b * (pp - q) * k / (fa * denom * denom);
                         let dc = 2.0 * (self.c1 * wc - self.c2 * (1.0 - wc)) * dw;
-                        k + dc * f.delta_dot_m_s
+                        (k + dc * f.delta_dot_m_s, dc)
                     } else {
-                        0.0
+                        (0.0, 0.0)
                     };
-                    (kd, c)
+                    (kd, c, dc)
                 }
                 None => {
                     let d = f.delta_m.max(0.0);
@@ -69,7 +86,7 @@ impl DropSystem {
                     } else {
                         0.0
                     };
-                    (kd, self.c1)
+                    (kd, self.c1, 0.0)
                 }
             };
             let (fnn, ft) = (f.normal_n, f.friction_n);
@@ -112,6 +129,36 @@ impl DropSystem {
             block(VR, QR, -dfc_dd * ir);
             block(VR, VR, -dfc_dw * ir);
             let race = self.series.is_none();
+            // Quadrature rows: eq. 17's H_s = F_t v_rel and the contact damper's power
+            // c delta_dot^2, over d, w and the spins (the race's columns with the other sign).
+            let (v_rel, dd) = (f.v_rel_m_s, f.delta_dot_m_s);
+            let dhs_dd = v_rel * dft_dd + ft * (rp.transpose() * w / dist);
+            let dhs_dw = v_rel * dft_dw + ft * t;
+            let dpd_dd = (2.0 * c * dd / dist) * pw + (dd * dd * dc) * n;
+            let dpd_dw = (2.0 * c * dd) * n;
+            {
+                let mut row = |r: usize, col: usize, v: Vector2<f64>| {
+                    let mut seg = sj.quad.fixed_view_mut::<1, 2>(r, col);
+                    seg += v.transpose();
+                };
+                row(FRIC, QR, dhs_dd);
+                row(FRIC, VR, dhs_dw);
+                row(DAMP, QR, dpd_dd);
+                row(DAMP, VR, dpd_dw);
+                if race {
+                    row(FRIC, QB, -dhs_dd);
+                    row(FRIC, VB, -dhs_dw);
+                    row(DAMP, QB, -dpd_dd);
+                    row(DAMP, VB, -dpd_dw);
+                }
+            }
+            sj.quad[(FRIC, SR)] += v_rel * dft_dwr + ft * self.r_r;
+            sj.quad[(FRIC, SB)] += v_rel * dft_dwb - ft * self.r_b;
+            if !race && fnn > 0.0 {
+                // The quasi-static race's support carries the contact force.
+                dload[0] = dfn_dd;
+                dload[1] = dfn_dw;
+            }
             if race {
                 block(VR, QB, dfc_dd * ir);
                 block(VR, VB, dfc_dw * ir);
@@ -169,6 +216,28 @@ impl DropSystem {
                 let mut v = j.fixed_view_mut::<2, 2>(VB, VB);
                 v -= (self.c2 * ib) * nb * nb.transpose();
                 v -= (self.c2_t * ib) * pb;
+                // The support dampers' power c2 r_dot^2 + c2_t |P v|^2.
+                let mut seg = sj.quad.fixed_view_mut::<1, 2>(DAMP, QB);
+                seg += ((2.0 * vn * (self.c2 - self.c2_t) / r) * pv).transpose();
+                let mut seg = sj.quad.fixed_view_mut::<1, 2>(DAMP, VB);
+                seg += (2.0 * self.c2 * vn * nb + 2.0 * self.c2_t * pv).transpose();
+                dload[2] = kd * nb + (self.c2 / r) * pv;
+                dload[3] = self.c2 * nb;
+            }
+        }
+        if let Some(p) = &self.drag {
+            // The drag's power M |omega_b| (regularised: M dir(omega_b) omega_b), over the
+            // race's spin and, through the Palmgren load, the support force's state.
+            let wb = y[WB];
+            let load = f.support_n + self.thermal_load_n;
+            let m = p.torque_n_m(wb, load);
+            let (dm_dw, dm_dload) = p.torque_slopes(wb, load);
+            let (dir, ddir) = drag::direction_and_slope(wb, self.omega_eps);
+            sj.quad[(DRAG, SB)] += dm_dw * dir * wb + m * (ddir * wb + dir);
+            let scale = dm_dload * dir * wb;
+            for (g, col) in dload.iter().zip([QR, VR, QB, VB]) {
+                let mut seg = sj.quad.fixed_view_mut::<1, 2>(DRAG, col);
+                seg += (scale * g).transpose();
             }
         }
         sj

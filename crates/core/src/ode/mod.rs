@@ -30,5 +30,6 @@ pub use rosw::Ros34pw2;
 pub use step::{Dense, Stats, StepControl};
 pub use stepper::Stepper;
 pub use system::{
-    GuardSet, JacobianMatrix, NoGuard, OdeSystem, StiffJacobian, MAX_GUARDS, MAX_STIFF,
+    GuardSet, JacobianMatrix, NoGuard, OdeSystem, QuadratureRows, StiffJacobian, MAX_GUARDS,
+    MAX_QUAD, MAX_STIFF,
 };

@@ -29,6 +29,12 @@ pub const MAX_STIFF: usize = 10;
 /// The matrix of a [`StiffJacobian`] (nalgebra's fixed-size storage).
 pub type JacobianMatrix = nalgebra::SMatrix<f64, MAX_STIFF, MAX_STIFF>;
 
+/// Most quadrature rows a [`StiffJacobian`] may hold.
+pub const MAX_QUAD: usize = 5;
+
+/// The quadrature rows of a [`StiffJacobian`] over its coupled components.
+pub type QuadratureRows = nalgebra::SMatrix<f64, MAX_QUAD, MAX_STIFF>;
+
 /// An approximate Jacobian restricted to a few state components, for the linearly implicit
 /// stepper ([`super::Ros34pw2`]): `jac[(a, b)]` approximates `d f_{idx[a]} / d y_{idx[b]}`; every
 /// entry outside these rows and columns is taken as zero.
@@ -46,6 +52,18 @@ pub struct StiffJacobian {
     /// remaining `len - kinematic` components (a Schur complement). 0 (the default of
     /// [`StiffJacobian::over`]): no such structure is claimed. At most `len / 2`.
     pub kinematic: usize,
+    /// Quadrature components: accumulators `q' = g(y)` whose effect on the coupled components
+    /// the matrix leaves out (energy integrals, which nothing reads; angles, read only by terms
+    /// left out). The first `quad_len` entries are used; none by default.
+    pub quad_idx: [usize; MAX_QUAD],
+    /// How many quadrature rows are held.
+    pub quad_len: usize,
+    /// `quad[(a, b)]` approximates `d g_a / d y_{idx[b]}` for quadrature `quad_idx[a]`; its
+    /// columns outside the coupled components are taken as zero. With these rows the matrix
+    /// `I - h gamma J` is block lower triangular: the stepper solves the coupled block, then
+    /// adds `h gamma (quad u)` to each quadrature. A Rosenbrock method (RODAS4) needs them to
+    /// keep its order on the accumulators; a W-method keeps it without.
+    pub quad: QuadratureRows,
 }
 
 impl StiffJacobian {
@@ -56,6 +74,9 @@ impl StiffJacobian {
             len: idx.len(),
             jac: JacobianMatrix::zeros(),
             kinematic: 0,
+            quad_idx: [0; MAX_QUAD],
+            quad_len: 0,
+            quad: QuadratureRows::zeros(),
         };
         s.idx[..idx.len()].copy_from_slice(idx);
         s
