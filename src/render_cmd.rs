@@ -9,9 +9,9 @@
 
 use std::path::{Path, PathBuf};
 
-use whirlmap_plot::{render_all, ChartError};
+use whirlmap_plot::{render_all_keeping, ChartError, FIG3_ORBITS};
 use whirlmap_sweep::folder::{self, FolderLock};
-use whirlmap_sweep::results::files::{ADAPTIVE_FILE, CONTOURS_FILE, POINTS_FILE};
+use whirlmap_sweep::results::files::{ADAPTIVE_FILE, CONTOURS_FILE, ORBITS_DIR, POINTS_FILE};
 
 /// Arguments of `whirlmap render`.
 #[derive(clap::Args)]
@@ -70,7 +70,32 @@ pub fn run(a: &RenderArgs) -> Result<(), RenderFailure> {
     for w in &checked.warnings {
         errln!("warning: {w}");
     }
-    let written = render_all(&a.dir).map_err(|e: ChartError| {
+    // Orbit files the run wrote but the folder no longer holds (a clone of the repository
+    // leaves them out): Fig. 3 cannot be redrawn, and is kept as the run drew it.
+    let missing_orbits = checked
+        .manifest
+        .as_ref()
+        .and_then(|m| m.files.as_ref())
+        .map(|files| {
+            files
+                .keys()
+                .filter(|rel| rel.starts_with(&format!("{ORBITS_DIR}/")))
+                .filter(|rel| !a.dir.join(rel).is_file())
+                .count()
+        })
+        .unwrap_or(0);
+    let keep: &[&str] = if missing_orbits > 0 {
+        errln!(
+            "warning: {missing_orbits} orbit file(s) the run wrote are not in {} (a clone of \
+             the repository leaves {ORBITS_DIR}/ out): {FIG3_ORBITS} is kept as the run drew it; \
+             rerun the sweep to redraw it",
+            a.dir.join(ORBITS_DIR).display()
+        );
+        &[FIG3_ORBITS]
+    } else {
+        &[]
+    };
+    let written = render_all_keeping(&a.dir, keep).map_err(|e: ChartError| {
         if e.is_output() {
             RenderFailure::Output(e.into())
         } else {

@@ -209,3 +209,29 @@ fn render_leaves_a_committed_manifest_as_it_was() {
     let after = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
     assert!(before == after, "render rewrote manifest.json");
 }
+
+#[test]
+fn render_keeps_fig3_when_the_orbit_files_are_not_in_the_folder() {
+    // A clone of the repository has the main job's charts and manifest but not its orbit
+    // files (left out for their size): render redraws the rest, keeps Fig. 3 as the run drew
+    // it, says why, and leaves the manifest as it was.
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("results/paper");
+    let dir = temp_dir("no-orbits");
+    copy_tree(&src, &dir);
+    let _ = std::fs::remove_dir_all(dir.join("orbits"));
+    let fig3 = dir.join("charts/fig3_orbits.png");
+    let before = std::fs::read(&fig3).unwrap();
+    let manifest = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
+    let out = whirlmap(&["render".as_ref(), dir.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("orbit file(s) the run wrote are not in") && stderr.contains("fig3_orbits"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read(&fig3).unwrap(), before, "Fig. 3 changed");
+    assert!(dir.join("charts/fig3_orbits.svg").is_file());
+    let after = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
+    assert!(manifest == after, "render rewrote manifest.json");
+    let _ = std::fs::remove_dir_all(&dir);
+}

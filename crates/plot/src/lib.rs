@@ -46,4 +46,4 @@ pub mod thermal;
 
 pub use error::ChartError;
 pub use load::{load_critical, load_orbits, load_points, load_probability};
-pub use render_all::render_all;
+pub use render_all::{render_all, render_all_keeping, FIG3_ORBITS};

@@ -55,6 +55,14 @@ fn wanted_charts(dir: &Path) -> Option<Vec<String>> {
 /// `contours.json` (an ensemble's) exists (then `points.jsonl` is optional). A sweep whose
 /// spec lists its `charts` gets only those. Returns the paths written.
 pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
+    render_all_keeping(dir, &[])
+}
+
+/// [`render_all`], leaving the charts named in `keep` (file stems such as
+/// [`FIG3_ORBITS`]) as they are when this rendering does not draw them: a chart whose
+/// data the run wrote but the folder no longer holds (orbit files left out of a repository)
+/// is kept rather than removed as stale.
+pub fn render_all_keeping(dir: &Path, keep: &[&str]) -> Result<Vec<PathBuf>, ChartError> {
     // An ensemble's results: Fig. 4 with probability bands (docs/probability.md).
     let prob = crate::probability::render_probability(dir)?;
     if !prob.is_empty() && !dir.join(POINTS_FILE).exists() {
@@ -143,16 +151,25 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         };
         write_both(
             &out_dir,
-            "fig3_orbits",
+            FIG3_ORBITS,
             orbit_figure_size(orbits.len()),
             &fig3,
             &mut written,
         )?;
     }
     written.extend(prob);
-    remove_stale_charts(&out_dir, &written)?;
+    let mut spared = written.clone();
+    for stem in keep {
+        for ext in ["png", "svg"] {
+            spared.push(out_dir.join(format!("{stem}.{ext}")));
+        }
+    }
+    remove_stale_charts(&out_dir, &spared)?;
     Ok(written)
 }
+
+/// The file stem of Fig. 3 (orbits) in a results folder's `charts/`.
+pub const FIG3_ORBITS: &str = "fig3_orbits";
 
 /// Removes the charts in `dir` that this rendering did not draw (a Fig. 4 left from an
 /// earlier spec with a critical search, say), so `charts/` shows only what the data holds.
