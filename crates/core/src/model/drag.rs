@@ -113,6 +113,51 @@ mod tests {
     }
 
     #[test]
+    fn slopes_match_central_differences() {
+        let b = bearing();
+        // Above eq. 12's low-speed constant, either sign of the speed; below it (flat).
+        for omega in [-900.0, -50.0, 30.0, 400.0, 3000.0, 0.5] {
+            for load in [0.0, 3.0, 500.0, 20_000.0] {
+                let (dw, dl) = b.torque_slopes(omega, load);
+                let h = 1e-6 * f64::abs(omega);
+                let fd_w =
+                    (b.torque_n_m(omega + h, load) - b.torque_n_m(omega - h, load)) / (2.0 * h);
+                assert!(
+                    (dw - fd_w).abs() <= 1e-6 * fd_w.abs() + 1e-15,
+                    "omega {omega}: {dw} {fd_w}"
+                );
+                if load > 0.0 {
+                    let h = 1e-6 * load;
+                    let fd_l =
+                        (b.torque_n_m(omega, load + h) - b.torque_n_m(omega, load - h)) / (2.0 * h);
+                    assert!(
+                        (dl - fd_l).abs() <= 1e-6 * fd_l.abs(),
+                        "load {load}: {dl} {fd_l}"
+                    );
+                } else {
+                    assert_eq!(dl, 0.0);
+                }
+            }
+        }
+        for (omega, eps) in [
+            (0.0, 0.1),
+            (0.03, 0.1),
+            (-0.25, 0.1),
+            (1.5, 0.1),
+            (5.0, 0.1),
+        ] {
+            let (d, slope) = direction_and_slope(omega, eps);
+            assert_eq!(d, direction(omega, eps));
+            let h = 1e-7;
+            let fd = (direction(omega + h, eps) - direction(omega - h, eps)) / (2.0 * h);
+            assert!(
+                (slope - fd).abs() <= 1e-6 * fd.abs() + 1e-9,
+                "omega {omega}: {slope} {fd}"
+            );
+        }
+    }
+
+    #[test]
     fn torque_matches_a_hand_computed_catalogue_example() {
         // n = 5000 r/min, nu0 = 22 cSt: nu0 n = 110 000, (110 000)^(2/3) = 2295.77;
         // M0 = 1e-7 * 2 * 2295.77 * 51^3 = 60.907 N mm.

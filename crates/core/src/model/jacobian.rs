@@ -15,10 +15,11 @@ impl DropSystem {
     /// normal), the friction that follows them (eq. 8; the regularised law's slope in the
     /// slip velocity too), over the translations, their rates and the two spins. Left out,
     /// because they are not stiff: gravity, the unbalance terms, Palmgren drag, and the
-    /// sticking constraint's dependence on the state. Its quadrature rows (for RODAS4, which
-    /// keeps its order only with them) are the energy integrals' powers (eq. 17's H_s, the
-    /// dampers' power, the drag's M |omega_b| with eq. 13's load slope) and the two angles
-    /// (theta' = omega).
+    /// sticking constraint's dependence on the state. For RODAS4, which keeps its order only
+    /// with the exact Jacobian, the matrix also holds the drag's slopes (eqs. 11-13) and the
+    /// sticking constraint's (eq. 9), and its quadrature rows: the energy integrals' powers
+    /// (eq. 17's H_s, the dampers' power, the drag's M |omega_b|) and the two angles
+    /// (theta' = omega). Only the unbalance terms are left out then.
     #[inline]
     pub(super) fn stiff_jacobian_at(&self, y: &[f64; N]) -> StiffJacobian {
         use ix::*;
@@ -39,7 +40,6 @@ impl DropSystem {
         const DAMP: usize = 1;
         const DRAG: usize = 2;
         sj.quad_idx[..5].copy_from_slice(&[E_FRIC, E_DAMP, E_DRAG, TR, TB]);
-        sj.quad_len = 5;
         sj.quad[(3, SR)] = 1.0;
         sj.quad[(4, SB)] = 1.0;
         // The gradient of the load the drag sees (the support force) over the rotor's and
@@ -96,6 +96,9 @@ impl DropSystem {
             // Friction: d F_t over d, w and the two spins.
             let (mut dft_dd, mut dft_dw, mut dft_dwr, mut dft_dwb) =
                 (Vector2::zeros(), Vector2::zeros(), 0.0, 0.0);
+            // While sticking (exact Jacobian only): the constraint's friction also follows the
+            // race's own position and velocity, through the support force.
+            let mut sticking: Option<StickingSlopes> = None;
             match self.friction.slopes(self.mode.slip, fnn, f.v_rel_m_s) {
                 FrictionSlopes::Smooth {
                     per_normal,
@@ -112,7 +115,13 @@ impl DropSystem {
                     dft_dd = per_normal * dfn_dd;
                     dft_dw = per_normal * dfn_dw;
                 }
-                FrictionSlopes::Constraint => {}
+                FrictionSlopes::Constraint => {
+                    if self.exact_jacobian && self.series.is_none() {
+                        let g = self.sticking_slopes(y, &f, w, rp, p);
+                        (dft_dd, dft_dw, dft_dwb) = (g.dd, g.dw, g.dwb);
+                        sticking = Some(g);
+                    }
+                }
             }
             // Force on the race fc = F_n n + F_t t (the rotor gets -fc), over d and w.
             let dfc_dd = n * dfn_dd.transpose()
@@ -129,35 +138,43 @@ impl DropSystem {
             block(VR, QR, -dfc_dd * ir);
             block(VR, VR, -dfc_dw * ir);
             let race = self.series.is_none();
-            // Quadrature rows: eq. 17's H_s = F_t v_rel and the contact damper's power
-            // c delta_dot^2, over d, w and the spins (the race's columns with the other sign).
-            let (v_rel, dd) = (f.v_rel_m_s, f.delta_dot_m_s);
-            let dhs_dd = v_rel * dft_dd + ft * (rp.transpose() * w / dist);
-            let dhs_dw = v_rel * dft_dw + ft * t;
-            let dpd_dd = (2.0 * c * dd / dist) * pw + (dd * dd * dc) * n;
-            let dpd_dw = (2.0 * c * dd) * n;
-            {
-                let mut row = |r: usize, col: usize, v: Vector2<f64>| {
-                    let mut seg = sj.quad.fixed_view_mut::<1, 2>(r, col);
-                    seg += v.transpose();
-                };
-                row(FRIC, QR, dhs_dd);
-                row(FRIC, VR, dhs_dw);
-                row(DAMP, QR, dpd_dd);
-                row(DAMP, VR, dpd_dw);
-                if race {
-                    row(FRIC, QB, -dhs_dd);
-                    row(FRIC, VB, -dhs_dw);
-                    row(DAMP, QB, -dpd_dd);
-                    row(DAMP, VB, -dpd_dw);
+            if self.exact_jacobian {
+                // Quadrature rows: eq. 17's H_s = F_t v_rel and the contact damper's power
+                // c delta_dot^2, over d, w and the spins (the race's columns with the other sign).
+                let (v_rel, dd) = (f.v_rel_m_s, f.delta_dot_m_s);
+                let dhs_dd = v_rel * dft_dd + ft * (rp.transpose() * w / dist);
+                let dhs_dw = v_rel * dft_dw + ft * t;
+                let dpd_dd = (2.0 * c * dd / dist) * pw + (dd * dd * dc) * n;
+                let dpd_dw = (2.0 * c * dd) * n;
+                {
+                    let mut row = |r: usize, col: usize, v: Vector2<f64>| {
+                        let mut seg = sj.quad.fixed_view_mut::<1, 2>(r, col);
+                        seg += v.transpose();
+                    };
+                    row(FRIC, QR, dhs_dd);
+                    row(FRIC, VR, dhs_dw);
+                    row(DAMP, QR, dpd_dd);
+                    row(DAMP, VR, dpd_dw);
+                    if race {
+                        row(FRIC, QB, -dhs_dd);
+                        row(FRIC, VB, -dhs_dw);
+                        row(DAMP, QB, -dpd_dd);
+                        row(DAMP, VB, -dpd_dw);
+                    }
                 }
-            }
-            sj.quad[(FRIC, SR)] += v_rel * dft_dwr + ft * self.r_r;
-            sj.quad[(FRIC, SB)] += v_rel * dft_dwb - ft * self.r_b;
-            if !race && fnn > 0.0 {
-                // The quasi-static race's support carries the contact force.
-                dload[0] = dfn_dd;
-                dload[1] = dfn_dw;
+                sj.quad[(FRIC, SR)] += v_rel * dft_dwr + ft * self.r_r;
+                sj.quad[(FRIC, SB)] += v_rel * dft_dwb - ft * self.r_b;
+                if let Some(g) = &sticking {
+                    let mut seg = sj.quad.fixed_view_mut::<1, 2>(FRIC, QB);
+                    seg += v_rel * g.qb.transpose();
+                    let mut seg = sj.quad.fixed_view_mut::<1, 2>(FRIC, VB);
+                    seg += v_rel * g.vb.transpose();
+                }
+                if !race && fnn > 0.0 {
+                    // The quasi-static race's support carries the contact force.
+                    dload[0] = dfn_dd;
+                    dload[1] = dfn_dw;
+                }
             }
             if race {
                 block(VR, QB, dfc_dd * ir);
@@ -192,6 +209,20 @@ impl DropSystem {
                 j[(row, SR)] += scale * dft_dwr;
                 j[(row, SB)] += scale * dft_dwb;
             }
+            if let Some(g) = &sticking {
+                // F_t's slopes in the race's position and velocity themselves: F_t t acts on
+                // the rotor (-) and the race (+), its torque on both spins.
+                for (col, v) in [(QB, g.qb), (VB, g.vb)] {
+                    let mut m = j.fixed_view_mut::<2, 2>(VR, col);
+                    m -= t * v.transpose() * ir;
+                    let mut m = j.fixed_view_mut::<2, 2>(VB, col);
+                    m += t * v.transpose() * ib;
+                    let mut r = j.fixed_view_mut::<1, 2>(SR, col);
+                    r -= (self.r_r / self.j_r) * v.transpose();
+                    let mut r = j.fixed_view_mut::<1, 2>(SB, col);
+                    r += (self.r_b / self.j_b) * v.transpose();
+                }
+            }
         }
         if self.series.is_none() && self.mode.support {
             let b = Vector2::new(y[XB], y[YB]);
@@ -216,16 +247,18 @@ impl DropSystem {
                 let mut v = j.fixed_view_mut::<2, 2>(VB, VB);
                 v -= (self.c2 * ib) * nb * nb.transpose();
                 v -= (self.c2_t * ib) * pb;
-                // The support dampers' power c2 r_dot^2 + c2_t |P v|^2.
-                let mut seg = sj.quad.fixed_view_mut::<1, 2>(DAMP, QB);
-                seg += ((2.0 * vn * (self.c2 - self.c2_t) / r) * pv).transpose();
-                let mut seg = sj.quad.fixed_view_mut::<1, 2>(DAMP, VB);
-                seg += (2.0 * self.c2 * vn * nb + 2.0 * self.c2_t * pv).transpose();
-                dload[2] = kd * nb + (self.c2 / r) * pv;
-                dload[3] = self.c2 * nb;
+                if self.exact_jacobian {
+                    // The support dampers' power c2 r_dot^2 + c2_t |P v|^2.
+                    let mut seg = sj.quad.fixed_view_mut::<1, 2>(DAMP, QB);
+                    seg += ((2.0 * vn * (self.c2 - self.c2_t) / r) * pv).transpose();
+                    let mut seg = sj.quad.fixed_view_mut::<1, 2>(DAMP, VB);
+                    seg += (2.0 * self.c2 * vn * nb + 2.0 * self.c2_t * pv).transpose();
+                    dload[2] = kd * nb + (self.c2 / r) * pv;
+                    dload[3] = self.c2 * nb;
+                }
             }
         }
-        if let Some(p) = &self.drag {
+        if let (true, Some(p)) = (self.exact_jacobian, &self.drag) {
             // The drag's power M |omega_b| (regularised: M dir(omega_b) omega_b), over the
             // race's spin and, through the Palmgren load, the support force's state.
             let wb = y[WB];
@@ -239,7 +272,102 @@ impl DropSystem {
                 let mut seg = sj.quad.fixed_view_mut::<1, 2>(DRAG, col);
                 seg += (scale * g).transpose();
             }
+            // The drag torque -M dir(omega_b) on the race's spin (eq. 6), which the W-method's
+            // matrix leaves out as not stiff.
+            j[(SB, SB)] -= (dm_dw * dir + m * ddir) / self.j_b;
+            let per_load = dm_dload * dir / self.j_b;
+            for (g, col) in dload.iter().zip([QR, VR, QB, VB]) {
+                let mut seg = j.fixed_view_mut::<1, 2>(SB, col);
+                seg -= (per_load * g).transpose();
+            }
         }
+        // The accumulators' rows, for the method that needs them.
+        sj.quad_len = if self.exact_jacobian { 5 } else { 0 };
         sj
     }
+
+    /// The slopes of the sticking constraint's friction (eq. 9 held: `v_rel' = 0`). The slip
+    /// acceleration is affine in `F_t`, `s(F_t) = s0 - K F_t` with the constant
+    /// `K = 1/m_r + 1/m_b + r_r^2/J_r + r_b^2/J_b` (without unbalance), so `F_t = s0 / K` and
+    /// its slopes are those of `s0 = -(S . t)/m_b - v_t delta_dot/|d| - M_b r_b/J_b`, the slip
+    /// acceleration without friction: `S` the support force on the race (eq. 7 and its
+    /// dampers), `M_b` the signed drag torque (eqs. 11-13).
+    fn sticking_slopes(
+        &self,
+        y: &[f64; N],
+        f: &super::forces::Forces,
+        w: Vector2<f64>,
+        rp: Matrix2<f64>,
+        p: Matrix2<f64>,
+    ) -> StickingSlopes {
+        use ix::*;
+        let k = 1.0 / self.m_r
+            + 1.0 / self.m_b
+            + self.r_r * self.r_r / self.j_r
+            + self.r_b * self.r_b / self.j_b;
+        let (n, t, dist) = (f.n, f.t, f.dist_m);
+        let (v_t, dd) = (w.dot(&t), f.delta_dot_m_s);
+        // The support force S and its slopes in the race's position and velocity.
+        let (mut s_vec, mut ds_db, mut ds_dvb) =
+            (Vector2::zeros(), Matrix2::zeros(), Matrix2::zeros());
+        let (mut dfs_db, mut dfs_dvb) = (Vector2::zeros(), Vector2::zeros());
+        let b = Vector2::new(y[XB], y[YB]);
+        let r = b.norm();
+        if self.mode.support && r > 0.0 {
+            let nb = b / r;
+            let vb = Vector2::new(y[VXB], y[VYB]);
+            let vn = vb.dot(&nb);
+            let pb = Matrix2::identity() - nb * nb.transpose();
+            let pv = pb * vb;
+            let kd = self.k2 * self.e2 * hertz::signed_pow(r, self.e2) / r;
+            let fs = f.support_n;
+            s_vec = -fs * nb - self.c2_t * pv;
+            dfs_db = kd * nb + (self.c2 / r) * pv;
+            dfs_dvb = self.c2 * nb;
+            ds_db = -(nb * dfs_db.transpose() + (fs / r) * pb)
+                + (self.c2_t / r) * (vn * pb + nb * pv.transpose());
+            ds_dvb = -(self.c2 * nb * nb.transpose()) - self.c2_t * pb;
+        }
+        // -(S . t)/m_b: t turns with d; S moves with the race.
+        let mut dd_grad = -(rp.transpose() * s_vec) / (dist * self.m_b);
+        let mut qb = -(ds_db.transpose() * t) / self.m_b;
+        let mut vb = -(ds_dvb.transpose() * t) / self.m_b;
+        // -v_t delta_dot / |d|.
+        let dw = -(dd * t + v_t * n) / dist;
+        dd_grad += -(dd * (rp.transpose() * w) + v_t * (p * w)) / (dist * dist)
+            + (v_t * dd / (dist * dist)) * n;
+        // -M_b r_b / J_b with M_b = -M dir(omega_b).
+        let mut dwb = 0.0;
+        if let Some(pg) = &self.drag {
+            let wb = y[WB];
+            let load = f.support_n + self.thermal_load_n;
+            let m = pg.torque_n_m(wb, load);
+            let (dm_dw, dm_dload) = pg.torque_slopes(wb, load);
+            let (dir, ddir) = drag::direction_and_slope(wb, self.omega_eps);
+            let c = self.r_b / self.j_b;
+            dwb = c * (dm_dw * dir + m * ddir);
+            qb += (c * dm_dload * dir) * dfs_db;
+            vb += (c * dm_dload * dir) * dfs_dvb;
+        }
+        // The race's relative position and velocity enter with d = p_r - p_b, w = v_r - v_b:
+        // the blocks give the race's columns the opposite sign of these.
+        StickingSlopes {
+            dd: dd_grad / k,
+            dw: dw / k,
+            dwb: dwb / k,
+            qb: qb / k,
+            vb: vb / k,
+        }
+    }
+}
+
+/// The sticking constraint's friction slopes ([`DropSystem`]'s `sticking_slopes`): over the
+/// relative position `d` and velocity `w` (the race's columns take them with the other sign),
+/// the race's spin, and the race's own position and velocity (through the support force).
+struct StickingSlopes {
+    dd: Vector2<f64>,
+    dw: Vector2<f64>,
+    dwb: f64,
+    qb: Vector2<f64>,
+    vb: Vector2<f64>,
 }

@@ -57,6 +57,10 @@ pub struct DropSystem {
     friction: Friction,
     drag: Option<drag::Palmgren>,
     omega_eps: f64,
+    /// Whether the stiff Jacobian holds the terms a Rosenbrock method needs for its order
+    /// (RODAS4): the accumulators' rows and the sticking constraint's slopes. A W-method
+    /// (ROS34PW2) keeps its order without them and is handed the cheaper matrix.
+    exact_jacobian: bool,
     free_max_step: f64,
     free_gap_bound: bool,
     f_ref: f64,
@@ -108,6 +112,7 @@ impl DropSystem {
                 c0_n: scene.static_load_rating_n,
             }),
             omega_eps: scene.drag_zero_speed_rad_s,
+            exact_jacobian: scene.solver.method == crate::scene::Method::Rodas4,
             free_max_step: scene.solver.free_flight_max_step_s,
             free_gap_bound: scene.solver.free_flight_gap_bound,
             f_ref: (m_r * g).max(1e-3),

@@ -14,16 +14,13 @@
 //! not depend on `t`), so the `h gamma_i f_t` terms of the non-autonomous form are left out.
 //!
 //! Unlike a W-method, a Rosenbrock method keeps its order only with the exact Jacobian: with
-//! the system's approximate stiff Jacobian ([`super::OdeSystem::stiff_jacobian`]) the order of
-//! the terms the matrix leaves out drops (the stepper harness measures it). So RODAS4 takes
-//! the Jacobian's quadrature rows ([`super::StiffJacobian::quad`]): on the drop model the
-//! energy integrals and the two angles, which without them set the step at an impact (their
-//! error estimate, not the motion's). With them, measured on 2026-11-24 at rtol 1e-5 with the
-//! gap bound and the race tolerance x100: 15 % fewer RHS evaluations on the 1 s pendulum drop,
-//! 21 % fewer on the whirl drop, and the friction heat 10-100 times closer to the reference
-//! (docs/accuracy.md#rodas4-measured). What the matrix still leaves out is the sticking
-//! constraint's dependence on the state. Dense output and the reuse of the end's derivative
-//! are ROS34PW2's: the cubic Hermite interpolant of the step's ends.
+//! an approximate one the order of the terms the matrix leaves out drops (the stepper harness
+//! measures it). So RODAS4 takes the Jacobian's quadrature rows ([`super::StiffJacobian::quad`]),
+//! and the drop model hands it the full matrix when the scene asks for RODAS4: the energy
+//! integrals' and the angles' rows (without them the energies' error estimate, not the
+//! motion's, set the step at an impact), the sticking constraint's slopes and the drag's.
+//! Measured on 2026-11-24 (docs/accuracy.md#rodas4-measured). Dense output and the reuse of
+//! the end's derivative are ROS34PW2's: the cubic Hermite interpolant of the step's ends.
 
 use super::control::{StepCore, StepLaw};
 use super::rosw::{rosenbrock_step, Lu, Rosenbrock};
