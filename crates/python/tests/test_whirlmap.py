@@ -156,7 +156,8 @@ def test_critical_rows() -> None:
     keys = {
         "mu", "onset_rpm", "bracket_rpm", "class_below", "class_above",
         "whirl_intervals_rpm", "whirl_at_range_top", "non_monotone", "drops",
-        "failed_drops", "converged", "from_rpm", "to_rpm", "resolution_rpm", "tol_rpm",
+        "failed_drops", "converged", "undecided", "from_rpm", "to_rpm", "resolution_rpm",
+        "tol_rpm",
         "duration_s", "scene_hash", "model_version", "note", "scan", "bisections",
     }  # fmt: skip
     for r in rows:
@@ -170,6 +171,24 @@ def test_critical_rows() -> None:
     assert rows[0]["recheck"]["fidelity"] == "standard"
     assert rows[1]["onset_rpm"] is None, "mu 0.1 does not whirl"
     json.dumps(rows)  # plain JSON types only
+
+
+def test_critical_warns_when_failed_drops_leave_the_onset_undecided() -> None:
+    # A step budget too small for any drop: every row is returned, with the warning.
+    message = r"undecided at mu 0.4 \(4 of 4 drops failed\)"
+    with pytest.warns(RuntimeWarning, match=message):
+        rows = whirlmap.critical(
+            0.4,
+            from_rpm=3000,
+            to_rpm=6000,
+            resolution_rpm=1000,
+            tol_rpm=250,
+            duration_s=0.3,
+            solver__max_step_attempts=3000,
+        )
+    assert len(rows) == 1
+    assert rows[0]["undecided"] is True and rows[0]["converged"] is False
+    assert rows[0]["failed_drops"] == 4
 
 
 def test_critical_checks_before_running() -> None:
