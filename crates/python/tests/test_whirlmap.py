@@ -156,8 +156,7 @@ def test_critical_rows() -> None:
     keys = {
         "mu", "onset_rpm", "bracket_rpm", "class_below", "class_above",
         "whirl_intervals_rpm", "whirl_at_range_top", "non_monotone", "drops",
-        "failed_drops", "converged", "undecided", "from_rpm", "to_rpm", "resolution_rpm",
-        "tol_rpm",
+        "failed_drops", "converged", "from_rpm", "to_rpm", "resolution_rpm", "tol_rpm",
         "duration_s", "scene_hash", "model_version", "note", "scan", "bisections",
     }  # fmt: skip
     for r in rows:

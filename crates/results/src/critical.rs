@@ -97,8 +97,9 @@ pub struct CriticalRow {
     /// Failed drops leave the onset undecided: every scan drop failed, or a drop failed
     /// below the reported onset (inside its bracket included), where a whirl would have
     /// given a lower onset, or anywhere in the range when no whirl was found. `note` names
-    /// the speeds. Rows written before this field existed read as false.
-    #[serde(default)]
+    /// the speeds. Written only when true, so a decided row's JSON (and every row written
+    /// before this field existed) reads back to the same bytes; absent reads as false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub undecided: bool,
     /// Lowest speed searched (r/min).
     pub from_rpm: f64,

@@ -852,6 +852,25 @@ mod tests {
             "{}",
             row.csv_line()
         );
+        // In the JSON only when true, so decided rows keep the bytes they always had.
+        let json = serde_json::to_string(&row).unwrap();
+        assert!(
+            json.contains(r#""converged":false,"undecided":true,"#),
+            "{json}"
+        );
+        let back: CriticalRow = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, row);
+        let o = opts(2000.0, 9000.0);
+        let decided = search(step_at(4400.0), &o)
+            .unwrap()
+            .into_row(0.4, &o, "x".into());
+        let json = serde_json::to_string(&decided).unwrap();
+        assert!(!json.contains("undecided"), "{json}");
+        assert!(
+            !serde_json::from_str::<CriticalRow>(&json)
+                .unwrap()
+                .undecided
+        );
     }
 
     #[test]

@@ -201,7 +201,8 @@ def critical(
         ``drops``, ``note``, ``scan``, ``bisections``, ...). ``pandas.DataFrame(rows)``
         reads them. A failed drop is recorded in its row; when failed drops leave a row's
         onset undecided (every scan drop failed, or one failed below the onset, or any
-        when no whirl was found), the row has ``undecided`` true and ``converged`` false.
+        when no whirl was found), the row has ``undecided`` true (the key is there only
+        then) and ``converged`` false.
 
     Warns:
         RuntimeWarning: Some row is undecided (the command line exits 1 then); the message
