@@ -3,13 +3,17 @@
 //!
 //! `--json` prints the same rows a sweep writes to `critical.json` (a list of
 //! [`CriticalRow`]); `--csv FILE` also writes them as `critical.csv` does. Exit codes as the
-//! rest of the tool: 2 for bad input (validated before any drop runs). Failed drops do not
-//! fail the command: they are reported in each row.
+//! rest of the tool: 2 for bad input (validated before any drop runs), 4 when the CSV or
+//! standard output cannot be written. Failed drops are reported in each row; when they leave
+//! a row's onset undecided (`undecided`, see docs/critical-speed.md) the command still prints
+//! and writes every row, names the friction coefficients on standard error and exits 1, as a
+//! sweep whose points failed does.
 
-use crate::{build_scene, Failure};
+use crate::{build_scene, CmdResult, Done, Failure};
 use std::path::PathBuf;
 use std::time::Instant;
 use whirlmap_core::InvalidParameter;
+use whirlmap_sweep::critical::undecided_summary;
 use whirlmap_sweep::critical::{
     check_mus, critical_rows_ticked, csv_text, fmt_rpm, CriticalOptions, CriticalRow,
     DEFAULT_RESOLUTION_RPM, DEFAULT_TOL_RPM,
@@ -84,7 +88,9 @@ fn flag_error(e: InvalidParameter) -> Failure {
     ))
 }
 
-pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
+/// Runs the subcommand: `Flagged` (exit 1) when failed drops left some row's onset
+/// undecided, after every row is printed and written.
+pub fn run(a: &CriticalArgs) -> CmdResult {
     let opts = CriticalOptions {
         from_rpm: a.from,
         to_rpm: a.to,
@@ -137,10 +143,24 @@ pub fn run(a: &CriticalArgs) -> Result<(), Failure> {
             "{}",
             serde_json::to_string_pretty(&rows).expect("results serialise")
         );
-        return Ok(());
+    } else {
+        print_table(a, &rows, wall_s);
     }
-    print_table(a, &rows, wall_s);
-    Ok(())
+    Ok(Done::flagged_if(report_undecided(&rows)))
+}
+
+/// Says on standard error which rows failed drops left undecided (see
+/// [`undecided_summary`]); true when there is any. The sweep, shard and merge commands say
+/// it the same way about their `critical.json`.
+pub(crate) fn report_undecided(rows: &[CriticalRow]) -> bool {
+    let Some(list) = undecided_summary(rows) else {
+        return false;
+    };
+    errln!(
+        "error: failed drops leave the critical speed undecided at {list}; every row is \
+         written and its note says why"
+    );
+    true
 }
 
 fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
@@ -162,12 +182,24 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                 fmt_rpm(o),
                 fmt_rpm(lo),
                 fmt_rpm(hi),
-                if r.converged { "" } else { ", NOT converged" }
+                if r.undecided {
+                    ", UNDECIDED: failed drops below it"
+                } else if r.converged {
+                    ""
+                } else {
+                    ", NOT converged"
+                }
             ),
             (Some(o), None) => outln!(
-                "    onset of whirl      at or below {} r/min (whirl at the lowest speed)",
-                fmt_rpm(o)
+                "    onset of whirl      at or below {} r/min (whirl at the lowest speed{})",
+                fmt_rpm(o),
+                if r.undecided {
+                    "; UNDECIDED: failed drops below it"
+                } else {
+                    ""
+                }
             ),
+            _ if r.undecided => outln!("    onset of whirl      UNDECIDED (failed drops)"),
             _ => outln!("    onset of whirl      none in the range"),
         }
         outln!(

@@ -591,7 +591,7 @@ fn run() -> u8 {
                 render_cmd::RenderFailure::Input(e) => Failure::Input(e),
                 render_cmd::RenderFailure::Output(e) => Failure::Output(e),
             }),
-        Command::Critical(a) => critical_cmd::run(a).map(|()| Done::Clean),
+        Command::Critical(a) => critical_cmd::run(a),
         Command::Sweep(a) => sweep_cmd::run(a),
         Command::Accuracy(a) => accuracy_cmd::run_cmd(a).map(|()| Done::Clean),
         Command::Merge(a) => merge_cmd::run(a),

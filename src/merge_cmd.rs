@@ -1,7 +1,8 @@
 //! `whirlmap merge DIR... [--out DIR]`: join the shards of a sweep into one result (see
 //! `whirlmap_sweep::merge`; the charts are drawn by `whirlmap_plot`).
 //!
-//! Exit codes: 0 merged, every point ok; 1 merged, some point failed (recorded as data); 2
+//! Exit codes: 0 merged, every point ok; 1 merged, some point failed (recorded as data) or
+//! failed drops left a critical speed undecided (its row says so); 2
 //! refused (a point missing or present twice, shards of different specs, shard counts,
 //! model versions or builds, a shard still running or with a file its manifest does not
 //! list, a folder that is not a shard's, an output folder holding another run's results
@@ -27,7 +28,8 @@ pub struct MergeArgs {
     overwrite: bool,
 }
 
-/// Runs the subcommand: `Flagged` (exit 1) when some points failed.
+/// Runs the subcommand: `Flagged` (exit 1) when some points failed or failed drops left a
+/// critical speed undecided.
 pub fn run(a: &MergeArgs) -> CmdResult {
     let out = match &a.out {
         Some(o) => o.clone(),
@@ -52,11 +54,13 @@ pub fn run(a: &MergeArgs) -> CmdResult {
             for (class, n) in &o.classes {
                 outln!("  {class:<16} {n}");
             }
+            let critical = out.join(whirlmap_sweep::extras::CRITICAL_FILE);
+            let undecided = critical.is_file() && crate::sweep_cmd::critical_line(&out, &critical);
             outln!("  output           {}", out.display());
             if !o.charts.is_empty() {
                 outln!("  charts           {} files", o.charts.len());
             }
-            Ok(Done::flagged_if(o.failed > 0))
+            Ok(Done::flagged_if(o.failed > 0 || undecided))
         }
         Err(e) => Err(Failure::coded(e.exit_code(), e)),
     }

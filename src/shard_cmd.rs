@@ -1,8 +1,9 @@
 //! `whirlmap sweep FILE --shard I --shards N`: run one shard of a sweep (see
 //! `whirlmap_sweep::shard`). Exit codes as for a whole sweep: 0 every owned point ok, 1 some
-//! point failed (records still written), 2 bad input, 4 an output could not be written.
+//! point failed or failed drops left an owned critical speed undecided (records still
+//! written), 2 bad input, 4 an output could not be written.
 
-use crate::sweep_cmd::{counts, SweepArgs};
+use crate::sweep_cmd::{counts, critical_line, SweepArgs};
 use crate::{CmdResult, Done, Failure};
 use std::path::PathBuf;
 use whirlmap_sweep::pipeline::{self, Stages};
@@ -42,9 +43,10 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> CmdRe
         shard.label(),
         counts(&outcome)
     );
-    if let Some(p) = critical {
-        outln!("  critical speeds  {}", p.display());
-    }
+    let undecided = match critical {
+        Some(p) => critical_line(&opts.out_dir, &p),
+        None => false,
+    };
     outln!("  output           {}", opts.out_dir.display());
-    Ok(Done::flagged_if(outcome.failed > 0))
+    Ok(Done::flagged_if(outcome.failed > 0 || undecided))
 }

@@ -1,6 +1,7 @@
 //! `whirlmap sweep FILE`: run a grid of drops from a JSON sweep spec.
 //!
-//! Exit codes: 0 every point ok; 1 some point failed (records still written); 2 bad spec, an
+//! Exit codes: 0 every point ok; 1 some point failed, or failed drops left a critical speed
+//! undecided (records and every critical row still written); 2 bad spec, an
 //! unusable output folder, or one that is in use or holds another run's results (nothing
 //! run); 4 an output (records or charts) could not be written, a full disk included.
 
@@ -65,7 +66,36 @@ pub(crate) fn counts(outcome: &SweepOutcome) -> String {
     )
 }
 
-/// Runs the subcommand: `Flagged` (exit 1) when some points failed.
+/// Prints the summary line of the critical speeds in `dir` (`critical.json` at `path`),
+/// with how many rows failed drops left undecided, and says which on standard error (as
+/// `whirlmap critical` does). True when some row is undecided. The sweep, shard and merge
+/// commands share it.
+pub(crate) fn critical_line(dir: &Path, path: &Path) -> bool {
+    let rows = whirlmap_sweep::results::critical::read_critical(dir)
+        .ok()
+        .flatten()
+        .unwrap_or_default();
+    let undecided: Vec<String> = rows
+        .iter()
+        .filter(|r| r.undecided)
+        .map(|r| format!("mu {}", r.mu))
+        .collect();
+    if undecided.is_empty() {
+        outln!("  critical speeds  {}", path.display());
+        return false;
+    }
+    outln!(
+        "  critical speeds  {} ({} of {} undecided by failed drops: {})",
+        path.display(),
+        undecided.len(),
+        rows.len(),
+        undecided.join(", ")
+    );
+    crate::critical_cmd::report_undecided(&rows)
+}
+
+/// Runs the subcommand: `Flagged` (exit 1) when some points failed or failed drops left a
+/// critical speed undecided.
 pub fn run(a: &SweepArgs) -> CmdResult {
     let spec = spec::read(&a.file).map_err(|e| Failure::coded(2, e))?;
     if let (Some(i), Some(n)) = (a.shard, a.shards) {
@@ -105,9 +135,10 @@ pub fn run(a: &SweepArgs) -> CmdResult {
     let done =
         pipeline::run(&spec, &opts, None, &stages).map_err(|e| Failure::coded(e.exit_code(), e))?;
     let x = &done.extras;
-    if let Some(p) = &x.critical {
-        outln!("  critical speeds  {}", p.display());
-    }
+    let undecided = match &x.critical {
+        Some(p) => critical_line(&opts.out_dir, p),
+        None => false,
+    };
     if !x.orbits.is_empty() {
         outln!("  orbits           {} drops recorded", x.orbits.len());
     }
@@ -117,5 +148,5 @@ pub fn run(a: &SweepArgs) -> CmdResult {
     if let Some(written) = &done.charts {
         outln!("  charts           {} files", written.len());
     }
-    Ok(Done::flagged_if(done.outcome.failed > 0))
+    Ok(Done::flagged_if(done.outcome.failed > 0 || undecided))
 }

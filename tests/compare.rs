@@ -104,6 +104,7 @@ fn compare_exit_codes_thresholds_and_report() {
             whirl_intervals_rpm: vec![[hi, 12000.0]],
             whirl_at_range_top: true,
             converged: true,
+            undecided: false,
             scan: Vec::new(),
             bisections: Vec::new(),
             note: String::new(),

@@ -1,5 +1,6 @@
-//! End-to-end tests of `whirlmap critical`: a real search on the default scene, and bad
-//! input rejected with exit code 2 before any drop runs.
+//! End-to-end tests of `whirlmap critical`: a real search on the default scene, bad input
+//! rejected with exit code 2 before any drop runs, and failed drops that leave an onset
+//! undecided (exit 1 from `critical`, a sweep, a shard and a merge, every row written).
 
 mod common;
 use common::*;
@@ -256,4 +257,157 @@ fn bad_input_exits_2_naming_the_field_and_value() {
     // Missing --mu is a usage error (clap's exit code 2).
     let out = whirlmap(&["critical", "--from", "0", "--to", "10"]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// A step budget too small for the pendulum drops at mu 0.4 (at 4000 r/min and below they
+/// fail); the whirl drops, which stop early, finish.
+const TINY_BUDGET: &str = "solver.max_step_attempts=10000";
+
+#[test]
+fn failed_drops_that_leave_the_onset_undecided_exit_1_with_every_row_written() {
+    let dir = temp_dir("critical-undecided");
+    let csv = dir.join("critical.csv");
+    // Every scan drop fails (a budget of 3000): nothing is decided.
+    let all_failed = [
+        "critical",
+        "--mu",
+        "0.4",
+        "--set",
+        "solver.max_step_attempts=3000",
+        "--from",
+        "3000",
+        "--to",
+        "6000",
+        "--resolution-rpm",
+        "1000",
+        "--tol-rpm",
+        "250",
+        "--duration-s",
+        "0.3",
+        "--no-progress",
+        "--json",
+        "--csv",
+        s(&csv),
+    ];
+    let o = whirlmap(&all_failed);
+    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("undecided at mu 0.4 (4 of 4 drops failed)"),
+        "{err}"
+    );
+    let rows: serde_json::Value = serde_json::from_slice(&o.stdout).expect("stdout is JSON");
+    let r = &rows[0];
+    assert_eq!(
+        (&r["failed_drops"], &r["converged"], &r["undecided"]),
+        (&4.into(), &false.into(), &true.into()),
+        "{r}"
+    );
+    assert!(r["note"]
+        .as_str()
+        .unwrap()
+        .starts_with("UNDECIDED: every scan drop failed"));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let line = text.lines().nth(1).expect("the row is written");
+    assert!(
+        line.starts_with("0.4,") && line.contains(",4,4,false,true,"),
+        "{line}"
+    );
+
+    // Drops below the onset fail, one coefficient of two: the whirl found at 5000 r/min
+    // may start lower. The table names the undecided row; the decided one is kept.
+    let o = whirlmap(&[
+        "critical",
+        "--mu",
+        "0.4,0.45",
+        "--set",
+        TINY_BUDGET,
+        "--from",
+        "4000",
+        "--to",
+        "6000",
+        "--resolution-rpm",
+        "1000",
+        "--tol-rpm",
+        "250",
+        "--duration-s",
+        "0.3",
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("mu_d = 0.45") && text.contains("mu_d = 0.4"),
+        "{text}"
+    );
+    assert!(text.contains("UNDECIDED"), "{text}");
+    let err = stderr(&o);
+    assert!(err.contains("mu 0.4 (1 of 3 drops failed)"), "{err}");
+    assert!(!err.contains("mu 0.45"), "{err}");
+}
+
+#[test]
+fn a_sweep_shard_and_merge_exit_1_when_a_critical_speed_is_undecided() {
+    let dir = temp_dir("critical-undecided-sweep");
+    let spec = spec_file(
+        &dir,
+        "undecided",
+        r#"{"name": "undecided", "scene": {"solver": {"max_step_attempts": 10000}},
+ "duration_s": 0.3, "axes": {"speed_rpm": [8000], "mu": [0.4]},
+ "critical": {"mu": [0.4, 0.45], "speed_rpm": {"from": 4000, "to": 6000},
+              "resolution_rpm": 1000, "tol_rpm": 250}}"#,
+    );
+    let check_rows = |out: &std::path::Path| {
+        let rows = read_json(&out.join("critical.json"));
+        assert_eq!(rows.as_array().unwrap().len(), 2, "{rows}");
+        assert_eq!(rows[0]["undecided"], true, "{rows}");
+        assert_eq!(rows[0]["converged"], false, "{rows}");
+        let csv = std::fs::read_to_string(out.join("critical.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 3, "{csv}");
+    };
+    let single = dir.join("single");
+    let o = whirlmap(&["sweep", s(&spec), "--out", s(&single), "--no-progress"]);
+    // The grid point is fine: exit 1 is the critical search's.
+    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("1 points, 1 ok, 0 failed"), "{text}");
+    assert!(
+        text.contains("(1 of 2 undecided by failed drops: mu 0.4)"),
+        "{text}"
+    );
+    assert!(
+        stderr(&o).contains("undecided at mu 0.4 ("),
+        "{}",
+        stderr(&o)
+    );
+    check_rows(&single);
+    assert_eq!(read_json(&single.join("manifest.json"))["complete"], true);
+
+    // Shard 0 owns mu 0.4 (undecided), shard 1 mu 0.45; the merge says it again.
+    let mut shards = Vec::new();
+    for (i, code) in [(0, 1), (1, 0)] {
+        let d = dir.join(format!("shard-{i}"));
+        let o = whirlmap(&[
+            "sweep",
+            s(&spec),
+            "--shard",
+            &i.to_string(),
+            "--shards",
+            "2",
+            "--out",
+            s(&d),
+            "--no-progress",
+        ]);
+        assert_eq!(o.status.code(), Some(code), "shard {i}: {}", out(&o));
+        shards.push(d);
+    }
+    let merged = dir.join("merged");
+    let o = whirlmap(&["merge", s(&shards[0]), s(&shards[1]), "--out", s(&merged)]);
+    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    assert!(
+        stderr(&o).contains("undecided at mu 0.4 ("),
+        "{}",
+        stderr(&o)
+    );
+    check_rows(&merged);
 }

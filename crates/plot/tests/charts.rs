@@ -130,6 +130,7 @@ fn critical_row(mu: f64) -> CriticalRow {
         drops: 1,
         failed_drops: 0,
         converged: true,
+        undecided: false,
         from_rpm: 1000.0,
         to_rpm: 12000.0,
         resolution_rpm: 250.0,

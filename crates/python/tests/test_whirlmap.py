@@ -172,6 +172,24 @@ def test_critical_rows() -> None:
     json.dumps(rows)  # plain JSON types only
 
 
+def test_critical_warns_when_failed_drops_leave_the_onset_undecided() -> None:
+    # A step budget too small for any drop: every row is returned, with the warning.
+    message = r"undecided at mu 0.4 \(4 of 4 drops failed\)"
+    with pytest.warns(RuntimeWarning, match=message):
+        rows = whirlmap.critical(
+            0.4,
+            from_rpm=3000,
+            to_rpm=6000,
+            resolution_rpm=1000,
+            tol_rpm=250,
+            duration_s=0.3,
+            solver__max_step_attempts=3000,
+        )
+    assert len(rows) == 1
+    assert rows[0]["undecided"] is True and rows[0]["converged"] is False
+    assert rows[0]["failed_drops"] == 4
+
+
 def test_critical_checks_before_running() -> None:
     with pytest.raises(ValueError, match="to_rpm"):
         whirlmap.critical(0.4, from_rpm=5000, to_rpm=4000)

@@ -91,8 +91,16 @@ pub struct CriticalRow {
     pub drops: usize,
     /// Drops that failed (counted as neither class; see `scan` and `bisections`).
     pub failed_drops: usize,
-    /// Every bisection reached `tol_rpm`.
+    /// Every bisection reached `tol_rpm` and no failed drop leaves the onset undecided
+    /// (false whenever `undecided` is true).
     pub converged: bool,
+    /// Failed drops leave the onset undecided: every scan drop failed, or a drop failed
+    /// below the reported onset (inside its bracket included), where a whirl would have
+    /// given a lower onset, or anywhere in the range when no whirl was found. `note` names
+    /// the speeds. Written only when true, so a decided row's JSON (and every row written
+    /// before this field existed) reads back to the same bytes; absent reads as false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub undecided: bool,
     /// Lowest speed searched (r/min).
     pub from_rpm: f64,
     /// Highest speed searched (r/min).
@@ -119,7 +127,7 @@ pub struct CriticalRow {
 }
 
 /// The header of `critical.csv`.
-pub const CSV_HEADER: &str = "mu,onset_rpm,bracket_below_rpm,bracket_above_rpm,class_below,class_above,whirl_intervals_rpm,whirl_at_range_top,non_monotone,drops,failed_drops,converged,from_rpm,to_rpm,resolution_rpm,tol_rpm,note";
+pub const CSV_HEADER: &str = "mu,onset_rpm,bracket_below_rpm,bracket_above_rpm,class_below,class_above,whirl_intervals_rpm,whirl_at_range_top,non_monotone,drops,failed_drops,converged,undecided,from_rpm,to_rpm,resolution_rpm,tol_rpm,note";
 
 impl CriticalRow {
     /// The row's line of `critical.csv` (see [`CSV_HEADER`]): intervals as
@@ -146,6 +154,7 @@ impl CriticalRow {
             self.drops.to_string(),
             self.failed_drops.to_string(),
             self.converged.to_string(),
+            self.undecided.to_string(),
             self.from_rpm.to_string(),
             self.to_rpm.to_string(),
             self.resolution_rpm.to_string(),
@@ -165,6 +174,23 @@ pub fn csv_text(rows: &[CriticalRow]) -> String {
         s.push('\n');
     }
     s
+}
+
+/// The rows whose onset failed drops left undecided, as `mu 0.4 (4 of 4 drops failed),
+/// mu 0.5 (1 of 9 drops failed)`; `None` when there is none. The command line's message and
+/// exit code, and the Python package's warning, are built on it.
+pub fn undecided_summary(rows: &[CriticalRow]) -> Option<String> {
+    let list: Vec<String> = rows
+        .iter()
+        .filter(|r| r.undecided)
+        .map(|r| {
+            format!(
+                "mu {} ({} of {} drops failed)",
+                r.mu, r.failed_drops, r.drops
+            )
+        })
+        .collect();
+    (!list.is_empty()).then(|| list.join(", "))
 }
 
 /// The bracket cells of a search run again at a tighter fidelity preset.

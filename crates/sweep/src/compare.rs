@@ -661,6 +661,7 @@ mod tests {
             whirl_intervals_rpm: bracket.map(|b| vec![[b[1], 30000.0]]).unwrap_or_default(),
             whirl_at_range_top: bracket.is_some(),
             converged: true,
+            undecided: false,
             scan: Vec::new(),
             bisections: Vec::new(),
             note: String::new(),

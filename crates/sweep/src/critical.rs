@@ -53,7 +53,9 @@ const MAX_BISECTIONS: usize = 200;
 /// beside it.
 const BISECTION_FRACTIONS: [f64; 3] = [0.5, 0.375, 0.625];
 
-pub use whirlmap_results::critical::{csv_text, CriticalRow, Outcome, Probe, CSV_HEADER};
+pub use whirlmap_results::critical::{
+    csv_text, undecided_summary, CriticalRow, Outcome, Probe, CSV_HEADER,
+};
 
 /// Settings of a critical-speed search.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -202,6 +204,8 @@ pub struct SearchResult {
     pub whirl_at_range_top: bool,
     /// See [`CriticalRow::converged`].
     pub converged: bool,
+    /// See [`CriticalRow::undecided`].
+    pub undecided: bool,
     /// See [`CriticalRow::scan`].
     pub scan: Vec<Probe>,
     /// See [`CriticalRow::bisections`].
@@ -238,6 +242,7 @@ impl SearchResult {
             drops: self.drops(),
             failed_drops: self.failed_drops(),
             converged: self.converged,
+            undecided: self.undecided,
             from_rpm: o.from_rpm,
             to_rpm: o.to_rpm,
             resolution_rpm: o.resolution_rpm,
@@ -336,6 +341,36 @@ pub fn fmt_rpm(s: f64) -> String {
     }
 }
 
+/// The failed drops (their speeds, in the order given) that leave the onset undecided:
+/// those below the reported `onset` (inside its bracket included), where a whirl would
+/// have given a lower onset, or every one of them when no onset was found (a whirl interval
+/// may hide at any of them). Failed drops above the onset cannot change it; they are counted
+/// in the note and can only shift the whirl intervals above it.
+pub fn hiding_failures(onset: Option<f64>, failed_speeds: &[f64]) -> Vec<f64> {
+    failed_speeds
+        .iter()
+        .copied()
+        .filter(|&s| onset.is_none_or(|x| s < x))
+        .collect()
+}
+
+/// Speeds for a note, in increasing order: `3000, 4000, 5000` (at most five, then
+/// `and N more`).
+fn rpm_list(speeds: &[f64]) -> String {
+    let mut v = speeds.to_vec();
+    v.sort_by(f64::total_cmp);
+    let mut text = v
+        .iter()
+        .take(5)
+        .map(|&s| fmt_rpm(s))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if v.len() > 5 {
+        text.push_str(&format!(" and {} more", v.len() - 5));
+    }
+    text
+}
+
 /// The successful scan points and the transitions between neighbours (not yet bisected).
 fn transitions_of(scan: &[Probe]) -> Vec<((f64, OrbitClass), (f64, OrbitClass))> {
     let ok: Vec<(f64, OrbitClass)> = scan
@@ -379,7 +414,7 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
     let (mut onset, mut bracket, mut below, mut above) = (None, None, None, None);
     if ok.is_empty() {
         notes.push(format!(
-            "every scan drop failed ({failed} of {}): nothing decided",
+            "UNDECIDED: every scan drop failed ({failed} of {}): nothing decided",
             scan.len()
         ));
     } else if intervals.is_empty() {
@@ -406,8 +441,13 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
     } else {
         onset = Some(ok[0].0);
         above = Some(ok[0].1);
+        let lowest = if scan.first().is_some_and(|p| p.error.is_some()) {
+            "the lowest speed scanned that did not fail"
+        } else {
+            "the lowest speed scanned"
+        };
         notes.push(format!(
-            "whirl already at {} r/min, the lowest speed scanned: the onset is at or below it",
+            "whirl already at {} r/min, {lowest}: the onset is at or below it",
             fmt_rpm(ok[0].0)
         ));
     }
@@ -449,13 +489,41 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
             failed + bisection_failures
         ));
     }
-    let converged = transitions.iter().all(|t| t.converged);
-    if !converged {
+    let bisected = transitions.iter().all(|t| t.converged);
+    if !bisected {
         notes.push(format!(
             "a bisection stopped short of {} r/min (drops failed inside its bracket)",
             fmt_rpm(o.tol_rpm)
         ));
     }
+    let failed_speeds: Vec<f64> = scan
+        .iter()
+        .chain(transitions.iter().flat_map(|t| &t.probes))
+        .filter(|p| p.error.is_some())
+        .map(|p| p.speed_rpm)
+        .collect();
+    // Failed drops that could change the onset: see `hiding_failures`.
+    let hiding = hiding_failures(onset, &failed_speeds);
+    if !ok.is_empty() && !hiding.is_empty() {
+        notes.insert(
+            0,
+            match onset {
+                Some(x) => format!(
+                    "UNDECIDED: {} drop(s) failed below the onset {} r/min (at {} r/min), where \
+                 whirl would give a lower onset",
+                    hiding.len(),
+                    fmt_rpm(x),
+                    rpm_list(&hiding)
+                ),
+                None => format!(
+                    "UNDECIDED: {} drop(s) failed (at {} r/min), where whirl may hide",
+                    hiding.len(),
+                    rpm_list(&hiding)
+                ),
+            },
+        );
+    }
+    let undecided = ok.is_empty() || !hiding.is_empty();
     SearchResult {
         onset_rpm: onset,
         bracket_rpm: bracket,
@@ -463,7 +531,8 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
         class_above: above,
         whirl_intervals_rpm: intervals,
         whirl_at_range_top,
-        converged,
+        converged: bisected && !undecided,
+        undecided,
         bisections: transitions.into_iter().flat_map(|t| t.probes).collect(),
         scan,
         note: notes.join("; "),
@@ -748,6 +817,152 @@ mod tests {
         let r = search(g, &opts(2000.0, 9000.0)).unwrap();
         assert!(!r.converged);
         assert_eq!(r.bracket_rpm, Some([4250.0, 4500.0]));
+    }
+
+    /// `step_at(threshold)` with the drops at `failing` speeds failed.
+    fn step_failing_at(threshold: f64, failing: &[f64]) -> impl Fn(f64) -> Outcome + Sync + '_ {
+        move |s| {
+            if failing.contains(&s) {
+                Outcome::Failed("step_budget: test".into())
+            } else {
+                step_at(threshold)(s)
+            }
+        }
+    }
+
+    #[test]
+    fn a_failed_drop_below_the_onset_leaves_it_undecided() {
+        // The lattice point 3000 fails, well below the onset at 4400: had it whirled, the
+        // onset would be 3000 or lower.
+        let r = search(step_failing_at(4400.0, &[3000.0]), &opts(2000.0, 9000.0)).unwrap();
+        let [lo, hi] = r.bracket_rpm.unwrap();
+        assert!(lo < 4400.0 && 4400.0 <= hi && hi - lo <= 10.0);
+        assert!(r.undecided && !r.converged);
+        assert!(
+            r.note
+                .starts_with("UNDECIDED: 1 drop(s) failed below the onset")
+                && r.note.contains("(at 3000 r/min)"),
+            "{}",
+            r.note
+        );
+        let row = r.into_row(0.4, &opts(2000.0, 9000.0), "x".into());
+        assert!(row.undecided && !row.converged);
+        assert!(
+            row.csv_line().contains(",1,false,true,"),
+            "{}",
+            row.csv_line()
+        );
+        // In the JSON only when true, so decided rows keep the bytes they always had.
+        let json = serde_json::to_string(&row).unwrap();
+        assert!(
+            json.contains(r#""converged":false,"undecided":true,"#),
+            "{json}"
+        );
+        let back: CriticalRow = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, row);
+        let o = opts(2000.0, 9000.0);
+        let decided = search(step_at(4400.0), &o)
+            .unwrap()
+            .into_row(0.4, &o, "x".into());
+        let json = serde_json::to_string(&decided).unwrap();
+        assert!(!json.contains("undecided"), "{json}");
+        assert!(
+            !serde_json::from_str::<CriticalRow>(&json)
+                .unwrap()
+                .undecided
+        );
+    }
+
+    #[test]
+    fn a_failed_drop_inside_the_final_bracket_leaves_the_onset_undecided() {
+        // The first bisection midpoint of [4250, 4500] fails, just below the threshold; the
+        // bisection goes on beside it and its bracket closes around the failed speed.
+        let r = search(step_failing_at(4376.0, &[4375.0]), &opts(2000.0, 9000.0)).unwrap();
+        let [lo, hi] = r.bracket_rpm.unwrap();
+        assert!(lo < 4375.0 && 4375.0 < hi && hi - lo <= 10.0, "{lo} {hi}");
+        assert!(r.undecided && !r.converged, "{}", r.note);
+    }
+
+    #[test]
+    fn failed_drops_above_the_onset_leave_it_decided() {
+        // Failures in the whirl above the onset (a lattice point and the range top) cannot
+        // lower it: the row converges and the note counts them.
+        let r = search(
+            step_failing_at(4400.0, &[6000.0, 9000.0]),
+            &opts(2000.0, 9000.0),
+        )
+        .unwrap();
+        assert!(!r.undecided && r.converged, "{}", r.note);
+        assert_eq!(r.failed_drops(), 2);
+        assert!(r.note.contains("2 drop(s) failed"), "{}", r.note);
+        assert!(!r.note.contains("UNDECIDED"), "{}", r.note);
+    }
+
+    #[test]
+    fn without_whirl_any_failed_drop_leaves_the_row_undecided() {
+        // No whirl found: the failed drop at 5000 could hide a whirl interval.
+        let f = |s: f64| {
+            if s == 5000.0 {
+                Outcome::Failed("step_budget: test".into())
+            } else {
+                Outcome::Class(Pendulum)
+            }
+        };
+        let r = search(f, &opts(2000.0, 9000.0)).unwrap();
+        assert_eq!(r.onset_rpm, None);
+        assert!(r.undecided && !r.converged);
+        assert!(
+            r.note
+                .contains("UNDECIDED: 1 drop(s) failed (at 5000 r/min)"),
+            "{}",
+            r.note
+        );
+        // Every scan drop failing decides nothing.
+        let r = search(|_| Outcome::Failed("x".into()), &opts(0.0, 500.0)).unwrap();
+        assert!(r.undecided && !r.converged);
+        assert!(r.note.starts_with("UNDECIDED: every scan drop failed"));
+        // Whirl at the lowest speed that did not fail: the failed speeds below it decide.
+        let r = search(step_failing_at(0.0, &[2000.0]), &opts(2000.0, 3000.0)).unwrap();
+        assert_eq!((r.onset_rpm, r.bracket_rpm), (Some(2250.0), None));
+        assert!(r.undecided && !r.converged, "{}", r.note);
+        assert!(r
+            .note
+            .contains("the lowest speed scanned that did not fail"));
+        // Without failures nothing is undecided.
+        let r = search(step_at(4400.0), &opts(2000.0, 9000.0)).unwrap();
+        assert!(!r.undecided && r.converged);
+    }
+
+    #[test]
+    fn the_failures_that_hide_an_onset_are_those_below_it() {
+        assert_eq!(
+            hiding_failures(Some(4400.0), &[3000.0, 4400.0, 5000.0]),
+            vec![3000.0]
+        );
+        assert_eq!(
+            hiding_failures(None, &[3000.0, 5000.0]),
+            vec![3000.0, 5000.0]
+        );
+        assert!(hiding_failures(Some(4400.0), &[]).is_empty());
+        let speeds: Vec<f64> = (1..=7).rev().map(|k| 1000.0 * k as f64).collect();
+        assert_eq!(rpm_list(&speeds), "1000, 2000, 3000, 4000, 5000 and 2 more");
+    }
+
+    #[test]
+    fn the_summary_names_the_undecided_rows() {
+        let o = opts(2000.0, 9000.0);
+        let decided = search(step_at(4400.0), &o)
+            .unwrap()
+            .into_row(0.3, &o, "x".into());
+        let undecided = search(step_failing_at(4400.0, &[3000.0]), &o)
+            .unwrap()
+            .into_row(0.4, &o, "x".into());
+        assert_eq!(undecided_summary(std::slice::from_ref(&decided)), None);
+        let drops = undecided.drops;
+        assert_eq!(
+            undecided_summary(&[decided, undecided]),
+            Some(format!("mu 0.4 (1 of {drops} drops failed)"))
+        );
     }
 
     #[test]

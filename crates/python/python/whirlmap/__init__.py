@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from dataclasses import dataclass
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -198,7 +199,14 @@ def critical(
         of a sweep's ``critical.json`` (``mu``, ``onset_rpm``, ``bracket_rpm``,
         ``class_below``, ``class_above``, ``whirl_intervals_rpm``, ``converged``,
         ``drops``, ``note``, ``scan``, ``bisections``, ...). ``pandas.DataFrame(rows)``
-        reads them.
+        reads them. A failed drop is recorded in its row; when failed drops leave a row's
+        onset undecided (every scan drop failed, or one failed below the onset, or any
+        when no whirl was found), the row has ``undecided`` true (the key is there only
+        then) and ``converged`` false.
+
+    Warns:
+        RuntimeWarning: Some row is undecided (the command line exits 1 then); the message
+            names the friction coefficients and their failed drops. Every row is returned.
 
     Raises:
         ValueError: A bad option, friction coefficient or scene parameter (named, with its
@@ -216,7 +224,21 @@ def critical(
         _overrides(overrides),
         threads,
     )
-    return json.loads(text)
+    rows: List[Dict[str, Any]] = json.loads(text)
+    undecided = [
+        f"mu {r['mu']} ({r['failed_drops']} of {r['drops']} drops failed)"
+        for r in rows
+        if r.get("undecided")
+    ]
+    if undecided:
+        warnings.warn(
+            "failed drops leave the critical speed undecided at "
+            + ", ".join(undecided)
+            + "; every row is returned and its note says why",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    return rows
 
 
 def _flatten(prefix: str, value: Any, row: Dict[str, Any]) -> None:
