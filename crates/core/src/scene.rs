@@ -320,7 +320,7 @@ pub fn num(v: f64) -> String {
 
 /// A derived number for a message, to three significant digits (`45.3`, `4.53e-7`): the
 /// bounds and values a check computes, as opposed to [`num`]'s exact echo of an input.
-fn approx(v: f64) -> String {
+pub(crate) fn approx(v: f64) -> String {
     let a = v.abs();
     if a == 0.0 || !a.is_finite() {
         return v.to_string();
