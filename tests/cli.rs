@@ -321,3 +321,22 @@ fn an_unwritable_chart_path_is_refused_in_a_sentence_before_the_drop_runs() {
     assert!(!err.contains("Os {"), "no error dump: {err}");
     assert!(out.stdout.is_empty(), "nothing was simulated or printed");
 }
+
+#[test]
+fn a_stop_speed_at_or_above_the_release_speed_is_refused() {
+    let o = whirlmap(&[
+        "drop",
+        "--duration-s",
+        "0.05",
+        "--set",
+        "stop_speed_rpm=9000",
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("invalid stop_speed_rpm = 9000")
+            && err.contains("below the release speed |speed_rpm| = 8000"),
+        "{err}"
+    );
+    assert!(o.stdout.is_empty(), "nothing simulated: {}", out(&o));
+}
