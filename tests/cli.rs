@@ -340,3 +340,20 @@ fn a_stop_speed_at_or_above_the_release_speed_is_refused() {
     );
     assert!(o.stdout.is_empty(), "nothing simulated: {}", out(&o));
 }
+
+#[test]
+fn bench_refuses_zero_repetitions_and_its_help_says_fastest() {
+    let o = whirlmap(&["bench", "--reps", "0"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--reps") && err.contains("allowed >= 1"),
+        "{err}"
+    );
+    assert!(o.stdout.is_empty(), "nothing timed: {}", out(&o));
+    let help = out(&whirlmap(&["bench", "--help"]));
+    assert!(
+        help.contains("fastest") && !help.contains("median"),
+        "{help}"
+    );
+}
