@@ -357,3 +357,48 @@ fn bench_refuses_zero_repetitions_and_its_help_says_fastest() {
         "{help}"
     );
 }
+
+#[test]
+fn accuracy_messages_appear_once_and_an_empty_case_list_is_refused() {
+    let dir = temp_dir("accuracy-input");
+    let missing = dir.join("missing.json");
+    let o = whirlmap(&[
+        "accuracy",
+        "--cases",
+        s(&missing),
+        "--out",
+        s(&dir.join("o1")),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("missing.json"), "{err}");
+    assert_eq!(err.matches("os error 2").count(), 1, "{err}");
+    let bad = spec_file(
+        &dir,
+        "bad",
+        r#"{"rtol": [1e-4], "cases": [{"name": "a", "scene": {"clearence_m": 1e-4}}], "settings": []}"#,
+    );
+    let o = whirlmap(&["accuracy", "--cases", s(&bad), "--out", s(&dir.join("o2"))]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cases[0].scene") && err.contains("clearance_m"),
+        "{err}"
+    );
+    assert_eq!(err.matches("known:").count(), 1, "{err}");
+    let empty = spec_file(
+        &dir,
+        "empty",
+        r#"{"rtol": [1e-4], "cases": [], "settings": []}"#,
+    );
+    let out_dir = dir.join("o3");
+    let o = whirlmap(&["accuracy", "--cases", s(&empty), "--out", s(&out_dir)]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cases = []: allowed at least one case"),
+        "{err}"
+    );
+    assert!(!out_dir.exists(), "nothing written");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
