@@ -173,10 +173,10 @@ enum Command {
     Compare(compare_cmd::CompareArgs),
     /// Whirl probability per grid cell from seeded ensembles of drops, with probability
     /// contours and Fig. 4 with bands (exit 1 if any drop failed).
-    Ensemble(ensemble_cmd::EnsembleArgs),
+    Ensemble(ensemble_cmd::EnsembleCmdArgs),
     /// Adaptive refinement of the whirl boundary over speed x mu (`--compare-full` also runs
     /// the full fine grid and reports the agreement).
-    Adaptive(ensemble_cmd::EnsembleArgs),
+    Adaptive(ensemble_cmd::AdaptiveArgs),
 }
 
 #[derive(clap::Args)]
