@@ -152,7 +152,7 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         "ns/RHS",
         "model/step"
     );
-    // Every case's median time first, then the table (the estimate needs the DOPRI5 row).
+    // Every case's fastest time first, then the table (the estimate needs the DOPRI5 row).
     let mut rows = Vec::new();
     for c in &cases {
         let mut scene = Scene::paper();
