@@ -30,7 +30,9 @@ pub struct AccuracyArgs {
 
 /// Runs the study and writes `accuracy.csv`, `accuracy.md`, `study.json` and the charts.
 pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
-    let spec = AccuracySpec::load(&a.cases).map_err(|e| Failure::Input(e.into()))?;
+    // The error's text already carries its cause: `coded` keeps it from being printed twice
+    // (as the error and again as its source).
+    let spec = AccuracySpec::load(&a.cases).map_err(|e| Failure::coded(2, e))?;
     crate::refuse_existing_results(&a.out, a.overwrite).map_err(Failure::Input)?;
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create {}", a.out.display()))
@@ -51,8 +53,8 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
         a.threads
     );
     let study = pool.install(|| run(&spec)).map_err(|e| match e {
-        AccuracySpecError::Range { ref field, .. } if field == "cases" => Failure::Solve(e.into()),
-        e => Failure::Input(e.into()),
+        AccuracySpecError::Range { ref field, .. } if field == "cases" => Failure::coded(3, e),
+        e => Failure::coded(2, e),
     })?;
     let write = |name: &str, text: String| {
         let p = a.out.join(name);

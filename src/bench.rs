@@ -22,14 +22,24 @@ impl Observer<DropSystem, N> for EvalCount {
 /// Options of `whirlmap bench`.
 #[derive(clap::Args)]
 pub struct BenchArgs {
-    /// Repetitions per drop case (the median wall time is reported).
-    #[arg(long, default_value_t = 9)]
+    /// Repetitions per drop case, at least 1 (the fastest repetition's wall time is
+    /// reported).
+    #[arg(long, default_value_t = 9, value_parser = at_least_one)]
     reps: usize,
     /// Also run the long thermal scenes (`scenes/coast-down.json` to its stop speed and for
     /// 60 s, `scenes/runaway.json` for 60 s), each with the full model and with the `draft`
     /// fidelity (ROS34PW2, race tolerance x1000, rtol 1e-4), and compare them (about 30 s of CPU in all).
     #[arg(long)]
     coast_down: bool,
+}
+
+/// `--reps`: a whole number of at least 1 (clap exits 2 with the message otherwise).
+fn at_least_one(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        Ok(n) => Err(format!("{n} repetitions: allowed >= 1")),
+        Err(e) => Err(format!("{e}: allowed a whole number >= 1")),
+    }
 }
 
 /// The long thermal scenes, embedded so the bench needs no files.
@@ -62,7 +72,7 @@ struct Case {
 /// after a warm-up (on a shared machine every slower run was slowed by something else), its
 /// ratio to the baseline (the first row) and to the peer, and the work counts.
 pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
-    let reps = a.reps.max(1);
+    let reps = a.reps;
     let cases: [Case; 9] = [
         Case {
             name: "pendulum 1 s, standard (baseline)",
@@ -142,7 +152,7 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         "ns/RHS",
         "model/step"
     );
-    // Every case's median time first, then the table (the estimate needs the DOPRI5 row).
+    // Every case's fastest time first, then the table (the estimate needs the DOPRI5 row).
     let mut rows = Vec::new();
     for c in &cases {
         let mut scene = Scene::paper();
@@ -181,7 +191,7 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         .map_or(f64::NAN, |r| r.1);
     for (name, ms, r, evals) in &rows {
         let peer = ms / dopri * DOPRI5_OVER_PEER;
-        print_row(name, *ms, ms / base, peer, r, *evals);
+        print_row(name, *ms, Some(ms / base), peer, r, *evals);
     }
     outln!(
         "x peer: the row's time over the dopri5 rtol 1e-5 row's, times {DOPRI5_OVER_PEER} (that row \
@@ -239,7 +249,15 @@ fn rhs_cost() {
 /// One row of the bench table: time, ratios, the stepper's counts, the cost per RHS
 /// evaluation, and the force model's evaluations per accepted step, computed + reused (the
 /// stepper's stages, the guards, the monitor; reused ones are served by `DropSystem`'s memo).
-fn print_row(name: &str, ms: f64, x_base: f64, x_peer: f64, r: &DropReport, evals: ModelEvals) {
+/// The long thermal rows have no baseline ratio (`x_base` is `None`, printed `-`).
+fn print_row(
+    name: &str,
+    ms: f64,
+    x_base: Option<f64>,
+    x_peer: f64,
+    r: &DropReport,
+    evals: ModelEvals,
+) {
     let note = if r.stop_reason == StopReason::WhirlDecided {
         " (whirl decided)"
     } else {
@@ -247,10 +265,10 @@ fn print_row(name: &str, ms: f64, x_base: f64, x_peer: f64, r: &DropReport, eval
     };
     let st = &r.stats;
     outln!(
-        "{:<40} {:>8.2} {:>7.3} {:>7.3} {:>9} {:>7} {:>6} {:>6} {:>6} {:>6} {:>7.0} {:>12}{note}",
+        "{:<40} {:>8.2} {:>7} {:>7.3} {:>9} {:>7} {:>6} {:>6} {:>6} {:>6} {:>7.0} {:>12}{note}",
         name,
         ms,
-        x_base,
+        ratio_cell(x_base),
         x_peer,
         st.rhs_evals,
         st.steps,
@@ -265,6 +283,11 @@ fn print_row(name: &str, ms: f64, x_base: f64, x_peer: f64, r: &DropReport, eval
             evals.reused as f64 / st.steps as f64
         )
     );
+}
+
+/// A ratio for the table to three decimals, or `-` where the row has none.
+fn ratio_cell(x: Option<f64>) -> String {
+    x.map_or("-".to_string(), |x| format!("{x:.3}"))
 }
 
 /// CPU time of the calling thread (s), from `/proc/thread-self/schedstat` (Linux; its first
@@ -288,21 +311,14 @@ fn long_thermal_run(name: &str, scene: &Scene, duration_s: f64) -> anyhow::Resul
     let r = simulate_observed(scene, &opts, &mut count)?;
     let wall = t.elapsed().as_secs_f64();
     let cpu = c.zip(thread_cpu_s()).map(|(a, b)| b - a);
-    print_row(
-        name,
-        wall * 1e3,
-        f64::NAN,
-        wall * 1e3 / PEER_MS,
-        &r,
-        count.0,
-    );
+    print_row(name, wall * 1e3, None, wall * 1e3 / PEER_MS, &r, count.0);
     let th = r.thermal.as_ref().expect("a thermal scene");
     let per_60 = |x: f64| x * 60.0 / r.end_time_s;
     outln!(
-        "    {:.2} s simulated ({:?}): {:.0} dynamic RHS evaluations and {:.0} network steps per simulated second; \
+        "    {:.2} s simulated ({}): {:.0} dynamic RHS evaluations and {:.0} network steps per simulated second; \
          CPU {} ({} per 60 s simulated)",
         r.end_time_s,
-        r.stop_reason,
+        r.stop_reason.describe(),
         r.stats.rhs_evals as f64 / r.end_time_s,
         th.network_steps as f64 / r.end_time_s,
         cpu.map_or("n/a".into(), |c| format!("{c:.2} s")),
@@ -380,4 +396,22 @@ fn thermal_pairs() -> anyhow::Result<()> {
         print_thermal_differences(&full, &draft);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn repetitions_are_at_least_one() {
+        assert_eq!(at_least_one("9"), Ok(9));
+        assert!(at_least_one("0").unwrap_err().contains("allowed >= 1"));
+        assert!(at_least_one("-1").is_err());
+    }
+
+    #[test]
+    fn a_row_without_a_baseline_ratio_prints_a_dash() {
+        assert_eq!(ratio_cell(None), "-");
+        assert_eq!(ratio_cell(Some(1.23456)), "1.235");
+    }
 }

@@ -11,7 +11,7 @@ use whirlmap_sweep::ensemble::{self, run_ensemble};
 use whirlmap_sweep::folder::FolderLock;
 use whirlmap_sweep::sweep::SweepError;
 
-/// Arguments of `whirlmap ensemble` and `whirlmap adaptive`.
+/// Arguments of `whirlmap ensemble`, shared by `whirlmap adaptive` ([`AdaptiveArgs`]).
 #[derive(clap::Args)]
 pub struct EnsembleArgs {
     /// Ensemble file (JSON): a sweep file (name, scene, duration_s, axes) with an `ensemble`
@@ -30,7 +30,28 @@ pub struct EnsembleArgs {
     /// No progress lines.
     #[arg(long)]
     no_progress: bool,
-    /// (adaptive only) Also run the full fine grid and report how the boundaries agree.
+}
+
+/// Arguments of `whirlmap ensemble`: the shared ones, and a hidden `--compare-full` that is
+/// only there to be refused with a message saying it belongs to `adaptive`.
+#[derive(clap::Args)]
+pub struct EnsembleCmdArgs {
+    /// The arguments `adaptive` takes too.
+    #[command(flatten)]
+    common: EnsembleArgs,
+    /// Refused: the full-grid comparison is `adaptive`'s.
+    #[arg(long, hide = true)]
+    compare_full: bool,
+}
+
+/// Arguments of `whirlmap adaptive`: those of `ensemble`, and `--compare-full` (which only
+/// an adaptive map has, so `ensemble` refuses it).
+#[derive(clap::Args)]
+pub struct AdaptiveArgs {
+    /// The arguments `ensemble` takes too.
+    #[command(flatten)]
+    common: EnsembleArgs,
+    /// Also run the full fine grid and report how the boundaries agree.
     #[arg(long)]
     compare_full: bool,
 }
@@ -64,7 +85,15 @@ fn fmt_speed(v: Option<f64>) -> String {
 }
 
 /// Runs `whirlmap ensemble`.
-pub fn run_ensemble_cmd(a: &EnsembleArgs) -> CmdResult {
+pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
+    if args.compare_full {
+        return Err(Failure::coded(
+            2,
+            "--compare-full applies only to `whirlmap adaptive` (it compares an adaptive map \
+             with the full fine grid); an ensemble runs its whole grid already",
+        ));
+    }
+    let a = &args.common;
     let (spec, out, _lock) = load(a, "ensemble")?;
     let o = run_ensemble(&spec, &out, a.threads.map(|n| n as usize), !a.no_progress)
         .map_err(failure)?;
@@ -113,13 +142,14 @@ pub fn run_ensemble_cmd(a: &EnsembleArgs) -> CmdResult {
 }
 
 /// Runs `whirlmap adaptive`.
-pub fn run_adaptive_cmd(a: &EnsembleArgs) -> CmdResult {
+pub fn run_adaptive_cmd(args: &AdaptiveArgs) -> CmdResult {
+    let a = &args.common;
     let (spec, out, _lock) = load(a, "adaptive")?;
     let (r, path) = run_adaptive(
         &spec,
         &out,
         a.threads.map(|n| n as usize),
-        a.compare_full,
+        args.compare_full,
         !a.no_progress,
     )
     .map_err(failure)?;

@@ -151,7 +151,8 @@ enum Command {
     /// Print the JSON Schema of a scene, sweep or ensemble file, for editors to validate
     /// files against: type, default, unit, allowed range and source of every scene field.
     Schema(SchemaArgs),
-    /// Time a pendulum drop, a whirl drop and one right-hand-side evaluation.
+    /// Time nine reference drops (pendulum and whirl drops at the fidelity presets, model
+    /// variants, a high speed) and one right-hand-side evaluation.
     Bench(bench::BenchArgs),
     /// Draw the design charts (Figs. 3-6, class map) of a sweep's results directory into
     /// DIR/charts/ as PNG and SVG (exit 2 if DIR has no points.jsonl, 4 if writing fails).
@@ -172,10 +173,10 @@ enum Command {
     Compare(compare_cmd::CompareArgs),
     /// Whirl probability per grid cell from seeded ensembles of drops, with probability
     /// contours and Fig. 4 with bands (exit 1 if any drop failed).
-    Ensemble(ensemble_cmd::EnsembleArgs),
+    Ensemble(ensemble_cmd::EnsembleCmdArgs),
     /// Adaptive refinement of the whirl boundary over speed x mu (`--compare-full` also runs
     /// the full fine grid and reports the agreement).
-    Adaptive(ensemble_cmd::EnsembleArgs),
+    Adaptive(ensemble_cmd::AdaptiveArgs),
 }
 
 #[derive(clap::Args)]
@@ -215,7 +216,8 @@ struct DropArgs {
     temperatures: Option<PathBuf>,
     /// Analyse the touchdown bearing as the drop runs (ball loads, contact pressure against
     /// the 4.2 GPa static limit, fatigue damage, drops to failure) with the paper's pair, or
-    /// the scene's `bearing` if it has one. The dynamics do not change.
+    /// the scene's `bearing` if it has one (applied before --set, so `--set bearing.x=...`
+    /// works). The dynamics do not change.
     #[arg(long)]
     bearing: bool,
 }
@@ -309,17 +311,28 @@ fn build_scene(
     speed_rpm: Option<f64>,
     mu: Option<f64>,
 ) -> anyhow::Result<Scene> {
-    build_scene_with(file, sets, speed_rpm, mu, false)
+    build_scene_with(file, sets, speed_rpm, mu, Sections::default())
 }
 
-/// [`build_scene`], switching the thermal model on (defaults, unless the scene file has
-/// thermal parameters) before the `--set` overrides when `thermal`.
+/// The optional scene sections a flag switches on (`--thermal`, `--bearing`), with their
+/// defaults unless the scene file has them, before the `--set` overrides.
+#[derive(Clone, Copy, Default)]
+struct Sections {
+    /// `--thermal` (or `--temperatures`).
+    thermal: bool,
+    /// `--bearing`.
+    bearing: bool,
+}
+
+/// [`build_scene`], switching on the sections in `on` (the thermal model, the bearing
+/// analysis; defaults, unless the scene file has them) before the `--set` overrides, so
+/// `--bearing --set bearing.rows=3` works as `--thermal --set thermal.x=...` does.
 fn build_scene_with(
     file: Option<&Path>,
     sets: &[String],
     speed_rpm: Option<f64>,
     mu: Option<f64>,
-    thermal: bool,
+    on: Sections,
 ) -> anyhow::Result<Scene> {
     let mut scene = match file {
         Some(p) => {
@@ -335,8 +348,11 @@ fn build_scene_with(
         }
         None => Scene::paper(),
     };
-    if thermal && scene.thermal.is_none() {
+    if on.thermal && scene.thermal.is_none() {
         scene.thermal = Some(whirlmap_core::ThermalParams::default());
+    }
+    if on.bearing && scene.bearing.is_none() {
+        scene.bearing = Some(whirlmap_core::bearing::BearingPair::paper_71908_cd());
     }
     for s in sets {
         apply_assignment(&mut scene, s).with_context(|| format!("--set {s}"))?;
@@ -373,14 +389,14 @@ fn settings_note(scene: &Scene) -> String {
 }
 
 fn run_drop(a: &DropArgs) -> Result<(), Failure> {
-    let thermal = a.thermal || a.temperatures.is_some();
-    let mut scene = build_scene_with(a.scene.as_deref(), &a.set, a.speed_rpm, a.mu, thermal)
+    let on = Sections {
+        thermal: a.thermal || a.temperatures.is_some(),
+        bearing: a.bearing,
+    };
+    let mut scene = build_scene_with(a.scene.as_deref(), &a.set, a.speed_rpm, a.mu, on)
         .map_err(Failure::Input)?;
     if let Some(f) = a.fidelity {
         f.apply(&mut scene);
-    }
-    if a.bearing && scene.bearing.is_none() {
-        scene.bearing = Some(whirlmap_core::bearing::BearingPair::paper_71908_cd());
     }
     // Output paths are checked before the drop runs, not after.
     for p in [&a.orbit, &a.temperatures].into_iter().flatten() {

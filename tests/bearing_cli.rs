@@ -163,3 +163,77 @@ fn a_sweep_without_the_analysis_keeps_its_columns() {
     assert!(!out_dir.join("charts/drops_to_failure.png").exists());
     assert!(!out_dir.join("bearing.md").exists());
 }
+
+/// A drop that must be refused as bad input: exit 2, and the message on stderr.
+fn refused(extra: &[&str]) -> String {
+    let mut args = vec!["drop", "--duration-s", "0.05"];
+    args.extend_from_slice(extra);
+    let out = whirlmap(&args);
+    assert_eq!(out.status.code(), Some(2), "{extra:?}: {}", stderr(&out));
+    stderr(&out)
+}
+
+#[test]
+fn bad_bearing_fields_are_named_by_their_dotted_key_with_value_and_range() {
+    let e = refused(&["--set", "bearing={}", "--set", "bearing.rows=0"]);
+    assert!(
+        e.contains("invalid bearing.rows = 0: allowed [1, 8]"),
+        "{e}"
+    );
+    let e = refused(&[
+        "--set",
+        "bearing={}",
+        "--set",
+        "bearing.pitch_diameter_m=0.001",
+    ]);
+    assert!(
+        e.contains("bearing.pitch_diameter_m = 0.001")
+            && e.contains("bearing.ball_diameter_m = 0.0055"),
+        "{e}"
+    );
+    // Balls that cannot fit on the pitch circle.
+    let e = refused(&[
+        "--set",
+        "bearing={}",
+        "--set",
+        "bearing.ball_diameter_m=0.05",
+    ]);
+    assert!(e.contains("must fit on the pitch circle"), "{e}");
+    let e = refused(&[
+        "--bearing",
+        "--set",
+        "bearing.balls_per_row=200",
+        "--set",
+        "bearing.ball_diameter_m=0.01",
+    ]);
+    assert!(e.contains("must fit on the pitch circle"), "{e}");
+    // A rating that would make the damage infinite.
+    let e = refused(&[
+        "--set",
+        "bearing={}",
+        "--set",
+        "bearing.dynamic_rating_n=1e-300",
+    ]);
+    assert!(
+        e.contains("invalid bearing.dynamic_rating_n = 1e-300: allowed [1, 1e8] N"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_bearing_flag_is_applied_before_set() {
+    let three = record(&["--bearing", "--set", "bearing.rows=3"]);
+    let two = record(&["--bearing"]);
+    assert!(
+        three["peak_ball_load_n"].as_f64().unwrap() < two["peak_ball_load_n"].as_f64().unwrap(),
+        "three rows share the load: {} vs {}",
+        three["peak_ball_load_n"],
+        two["peak_ball_load_n"]
+    );
+    // Without the flag or the section, the hint names the bearing's own flag.
+    let e = refused(&["--set", "bearing.rows=3"]);
+    assert!(
+        e.contains("--set bearing={}") && e.contains("--bearing") && !e.contains("--thermal"),
+        "{e}"
+    );
+}

@@ -321,3 +321,84 @@ fn an_unwritable_chart_path_is_refused_in_a_sentence_before_the_drop_runs() {
     assert!(!err.contains("Os {"), "no error dump: {err}");
     assert!(out.stdout.is_empty(), "nothing was simulated or printed");
 }
+
+#[test]
+fn a_stop_speed_at_or_above_the_release_speed_is_refused() {
+    let o = whirlmap(&[
+        "drop",
+        "--duration-s",
+        "0.05",
+        "--set",
+        "stop_speed_rpm=9000",
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("invalid stop_speed_rpm = 9000")
+            && err.contains("below the release speed |speed_rpm| = 8000"),
+        "{err}"
+    );
+    assert!(o.stdout.is_empty(), "nothing simulated: {}", out(&o));
+}
+
+#[test]
+fn bench_refuses_zero_repetitions_and_its_help_says_fastest() {
+    let o = whirlmap(&["bench", "--reps", "0"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--reps") && err.contains("allowed >= 1"),
+        "{err}"
+    );
+    assert!(o.stdout.is_empty(), "nothing timed: {}", out(&o));
+    let help = out(&whirlmap(&["bench", "--help"]));
+    assert!(
+        help.contains("fastest") && !help.contains("median"),
+        "{help}"
+    );
+}
+
+#[test]
+fn accuracy_messages_appear_once_and_an_empty_case_list_is_refused() {
+    let dir = temp_dir("accuracy-input");
+    let missing = dir.join("missing.json");
+    let o = whirlmap(&[
+        "accuracy",
+        "--cases",
+        s(&missing),
+        "--out",
+        s(&dir.join("o1")),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("missing.json"), "{err}");
+    assert_eq!(err.matches("os error 2").count(), 1, "{err}");
+    let bad = spec_file(
+        &dir,
+        "bad",
+        r#"{"rtol": [1e-4], "cases": [{"name": "a", "scene": {"clearence_m": 1e-4}}], "settings": []}"#,
+    );
+    let o = whirlmap(&["accuracy", "--cases", s(&bad), "--out", s(&dir.join("o2"))]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cases[0].scene") && err.contains("clearance_m"),
+        "{err}"
+    );
+    assert_eq!(err.matches("known:").count(), 1, "{err}");
+    let empty = spec_file(
+        &dir,
+        "empty",
+        r#"{"rtol": [1e-4], "cases": [], "settings": []}"#,
+    );
+    let out_dir = dir.join("o3");
+    let o = whirlmap(&["accuracy", "--cases", s(&empty), "--out", s(&out_dir)]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("cases = []: allowed at least one case"),
+        "{err}"
+    );
+    assert!(!out_dir.exists(), "nothing written");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

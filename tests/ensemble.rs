@@ -203,3 +203,18 @@ fn adaptive_search_on_a_small_real_grid_matches_the_full_grid() {
     assert!(a["max_shift_cells"].as_f64().unwrap() <= 1.0, "{a}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn compare_full_belongs_to_adaptive_only() {
+    let o = whirlmap(&["ensemble", "no-such-file.json", "--compare-full"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--compare-full applies only to `whirlmap adaptive`"),
+        "{err}"
+    );
+    let help = out(&whirlmap(&["adaptive", "--help"]));
+    assert!(help.contains("--compare-full"), "{help}");
+    let help = out(&whirlmap(&["ensemble", "--help"]));
+    assert!(!help.contains("--compare-full"), "{help}");
+}

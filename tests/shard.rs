@@ -190,6 +190,14 @@ fn merged_shards_equal_the_single_run_byte_for_byte() {
     assert!(matches!(o.status.code(), Some(0 | 1)), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("4 shards, 9 points"));
     assert_same_result(&single, &merged);
+    // Merging again into the same folder is refused with the options merge has.
+    let o = merge(&shards, &merged);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--overwrite") && err.contains("--out") && !err.contains("--resume"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

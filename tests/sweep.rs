@@ -73,6 +73,13 @@ fn bad_specs_exit_2_name_the_field_and_run_nothing() {
             r#"{"name": "bad", "duration_s": 0.05, "axes": {"clearance_m": [1e-4, -1e-3]}}"#.into(),
             &["grid point 1", "clearance_m = -0.001"],
         ),
+        (
+            "a grid speed at or below the stop speed",
+            r#"{"name": "bad", "duration_s": 0.05, "scene": {"stop_speed_rpm": 5000},
+                "axes": {"speed_rpm": [8000, 4000]}}"#
+                .into(),
+            &["grid point 1", "stop_speed_rpm = 5000", "|speed_rpm| = 4000"],
+        ),
     ];
     for (i, (what, text, needles)) in cases.iter().enumerate() {
         let spec = dir.join(format!("case{i}.json"));

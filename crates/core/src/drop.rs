@@ -100,6 +100,18 @@ pub enum StopReason {
     StopSpeedReached,
 }
 
+impl StopReason {
+    /// The reason in words, for a person: `duration reached`, `whirl decided`, `stop speed
+    /// reached`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            StopReason::DurationReached => "duration reached",
+            StopReason::WhirlDecided => "whirl decided",
+            StopReason::StopSpeedReached => "stop speed reached",
+        }
+    }
+}
+
 /// The energy audit: initial = final + friction heat + damping loss + drag work.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct EnergyAudit {

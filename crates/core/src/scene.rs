@@ -269,7 +269,9 @@ pub struct Scene {
     pub quasi_static_race: bool,
     /// Stop the run once the rotor spin |omega_r| falls below this (r/min): the end of a
     /// coast-down. `null` (default, and left out of the scene's JSON so existing scene hashes
-    /// stay as they were): run to the duration. Allowed [0, 1e6].
+    /// stay as they were): run to the duration. Allowed [0, 1e6] and below the release speed
+    /// |speed_rpm| ([`Scene::validate_consistency`]): a run released at or below it would
+    /// stop before its first step.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stop_speed_rpm: Option<f64>,
     /// The thermal model (paper Sec. 3, eqs. 14-31); `null` (default, left out of the JSON):
@@ -320,7 +322,7 @@ pub fn num(v: f64) -> String {
 
 /// A derived number for a message, to three significant digits (`45.3`, `4.53e-7`): the
 /// bounds and values a check computes, as opposed to [`num`]'s exact echo of an input.
-fn approx(v: f64) -> String {
+pub(crate) fn approx(v: f64) -> String {
     let a = v.abs();
     if a == 0.0 || !a.is_finite() {
         return v.to_string();
@@ -709,7 +711,22 @@ impl Scene {
     ///   gives 2.5e-4 N and is refused, as is a stiffness kept when its exponent is changed
     ///   (k1 with e = 2 gives 2e-3 N). (k1 in N/mm^(10/9), 2154 times too small, gives 0.2 N:
     ///   inside the range, which must hold the extremes matrix's k x 1e-3, 0.43 N.)
+    /// - the stop speed `stop_speed_rpm`, if set, is below the release speed |speed_rpm|:
+    ///   otherwise the run would stop at release, with nothing simulated.
     pub fn validate_consistency(&self) -> Result<(), InvalidParameter> {
+        if let Some(stop) = self.stop_speed_rpm {
+            if !(stop < self.speed_rpm.abs()) {
+                return Err(InvalidParameter::new(
+                    "stop_speed_rpm",
+                    num(stop),
+                    &format!(
+                        "[0, |speed_rpm|) r/min, below the release speed |speed_rpm| = {} r/min \
+                         (a run released at or below its stop speed stops before it starts)",
+                        num(self.speed_rpm.abs())
+                    ),
+                ));
+            }
+        }
         let bore_d = 2.0 * self.race_bore_radius_m();
         if !(self.pitch_diameter_m > bore_d) {
             return Err(InvalidParameter::new(
@@ -911,6 +928,25 @@ mod tests {
         let mut s = Scene::paper();
         s.race_mass_kg = 0.0;
         assert_eq!(s.validate().unwrap_err().field, "race_mass_kg");
+    }
+
+    #[test]
+    fn the_stop_speed_must_be_below_the_release_speed() {
+        let mut s = Scene::paper();
+        s.stop_speed_rpm = Some(9000.0);
+        let e = s.validate().unwrap_err();
+        assert_eq!(e.field, "stop_speed_rpm");
+        assert!(
+            e.to_string().contains("= 9000:") && e.to_string().contains("|speed_rpm| = 8000"),
+            "{e}"
+        );
+        s.stop_speed_rpm = Some(8000.0);
+        assert_eq!(s.validate().unwrap_err().field, "stop_speed_rpm");
+        s.stop_speed_rpm = Some(7999.0);
+        s.validate().unwrap();
+        // The spin's sign is its direction: the bound is the magnitude.
+        s.speed_rpm = -8000.0;
+        s.validate().unwrap();
     }
 
     #[test]

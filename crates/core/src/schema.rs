@@ -35,8 +35,10 @@ const fn r(key: &'static str, min: Option<Bound>, max: Option<Bound>) -> FieldRa
 }
 use Bound::{Exclusive as Ex, Inclusive as In};
 
-/// Allowed ranges of the scene's numeric fields (the thermal model's under `thermal.`), as
-/// [`Scene::validate`] and [`crate::ThermalParams::validate`] enforce them.
+/// Allowed ranges of the scene's numeric fields (the thermal model's under `thermal.`, the
+/// bearing analysis's under `bearing.`), as [`Scene::validate`],
+/// [`crate::ThermalParams::validate`] and [`crate::bearing::BearingPair::validate_fields`]
+/// enforce them.
 pub const FIELD_RANGES: &[FieldRange] = &[
     r("speed_rpm", Some(In(-1e6)), Some(In(1e6))),
     r("mu_dynamic", Some(In(0.0)), Some(In(2.0))),
@@ -165,6 +167,27 @@ pub const FIELD_RANGES: &[FieldRange] = &[
         None,
     ),
     r("thermal.fit_interference_m", Some(In(0.0)), Some(In(1e-3))),
+    r("bearing.ball_diameter_m", Some(In(1e-4)), Some(In(0.1))),
+    r("bearing.pitch_diameter_m", Some(In(1e-3)), Some(In(10.0))),
+    r("bearing.balls_per_row", Some(In(3.0)), Some(In(1000.0))),
+    r("bearing.rows", Some(In(1.0)), Some(In(8.0))),
+    r("bearing.contact_angle_rad", Some(In(0.0)), Some(Ex(1.4))),
+    r("bearing.inner_conformity", Some(Ex(0.5)), Some(Ex(1.0))),
+    r("bearing.outer_conformity", Some(Ex(0.5)), Some(Ex(1.0))),
+    r("bearing.young_modulus_pa", Some(In(1e9)), Some(In(1e12))),
+    r("bearing.poisson_ratio", Some(In(0.0)), Some(Ex(0.5))),
+    r(
+        "bearing.lumped_stiffness_n_per_m1_5",
+        Some(In(1e6)),
+        Some(In(1e19)),
+    ),
+    r("bearing.dynamic_rating_n", Some(In(1.0)), Some(In(1e8))),
+    r("bearing.static_rating_n", Some(In(1.0)), Some(In(1e8))),
+    r(
+        "bearing.static_limit_pressure_pa",
+        Some(In(1e8)),
+        Some(In(1e10)),
+    ),
 ];
 
 /// The unit of a field, read from its name's suffix (the project's naming rule: SI units,
@@ -173,6 +196,7 @@ pub fn unit_of(key: &str) -> &'static str {
     let name = key.rsplit('.').next().unwrap_or(key);
     const SUFFIXES: &[(&str, &str)] = &[
         ("_n_per_m_e", "N/m^e (e the field's exponent)"),
+        ("_n_per_m1_5", "N/m^1.5"),
         ("_n_per_m15", "N/m^1.5"),
         ("_n_s_per_m", "N s/m"),
         ("_kg_m2", "kg m^2"),
@@ -188,6 +212,7 @@ pub fn unit_of(key: &str) -> &'static str {
         ("_rpm", "r/min"),
         ("_rad", "rad"),
         ("_deg", "deg"),
+        ("_pa", "Pa"),
         ("_kg", "kg"),
         ("_m", "m"),
         ("_s", "s"),
@@ -202,11 +227,21 @@ pub fn unit_of(key: &str) -> &'static str {
 }
 
 /// Where a field's value comes from, read from its doc comment: the paper's table or
-/// equation, a handbook (`[ASM]`, `[Harris]`, `[SKF]`, `[Incropera]`), or whirlmap's own
+/// equation, a handbook (`[ASM]`, `[Harris]`, `[SKF]`, `[Incropera]`), a standard
+/// (`[ISO 281]`, `[ISO 76]`), or whirlmap's own
 /// choice (documented in docs/model.md) when the paper gives none.
 pub fn source_of(description: &str) -> String {
+    // Doc comments escape the brackets of a marker for rustdoc (`\[ASM\]`).
+    let description = description.replace('\\', "");
     let mut found: Vec<String> = Vec::new();
-    for marker in ["[ASM]", "[Harris]", "[SKF]", "[Incropera]", "[Table 3]"] {
+    for marker in [
+        "[ASM]",
+        "[Harris]",
+        "[SKF]",
+        "[Incropera]",
+        "[ISO 281]",
+        "[ISO 76]",
+    ] {
         if description.contains(marker) {
             found.push(marker.trim_matches(['[', ']']).to_string());
         }
@@ -253,6 +288,7 @@ pub fn scene_schema() -> serde_json::Value {
         ("classification", "ClassifyParams"),
         ("solver", "SolverSettings"),
         ("thermal", "ThermalParams"),
+        ("bearing", "BearingPair"),
     ];
     fn annotate(props: &mut serde_json::Map<String, Value>, prefix: &str) {
         for (name, prop) in props.iter_mut() {
@@ -318,6 +354,7 @@ pub fn scene_schema() -> serde_json::Value {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bearing::BearingPair;
     use crate::scene::Scene;
     use crate::ThermalParams;
     use serde_json::Value;
@@ -327,13 +364,15 @@ mod tests {
     fn with(key: &str, v: f64) -> Option<Scene> {
         let mut s = Scene::paper();
         s.thermal = Some(ThermalParams::default());
+        s.bearing = Some(BearingPair::default());
         let mut root = serde_json::to_value(&s).unwrap();
         let mut node = &mut root;
         let parts: Vec<&str> = key.split('.').collect();
         for p in &parts[..parts.len() - 1] {
             node = node.get_mut(*p).unwrap();
         }
-        let value = if key.ends_with("ball_count") || key.starts_with("solver.max_") {
+        let integer = ["ball_count", "balls_per_row", "bearing.rows"];
+        let value = if integer.iter().any(|i| key.ends_with(i)) || key.starts_with("solver.max_") {
             if v < 0.0 || v.fract() != 0.0 {
                 return None;
             }
@@ -351,7 +390,10 @@ mod tests {
     /// between fields, which [`Scene::validate`] adds; the ranges are per field).
     fn check(s: &Scene) -> Result<(), crate::InvalidParameter> {
         s.validate_fields()?;
-        s.thermal.as_ref().map_or(Ok(()), ThermalParams::validate)
+        s.thermal.as_ref().map_or(Ok(()), ThermalParams::validate)?;
+        s.bearing
+            .as_ref()
+            .map_or(Ok(()), BearingPair::validate_fields)
     }
 
     fn accepted(key: &str, v: f64) -> bool {
@@ -434,6 +476,7 @@ mod tests {
             "the paper's Table 2"
         );
         assert_eq!(source_of("Default 46.6, AISI 52100 [ASM]."), "ASM");
+        assert_eq!(source_of("Default 46.6, AISI 52100 \\[ASM\\]."), "ASM");
         assert!(source_of("Default 22.").starts_with("not in the paper"));
         assert_eq!(
             source_of("Friction law. Default `switched` (the paper's)."),
@@ -467,5 +510,41 @@ mod tests {
         assert_eq!(clearance["x-source"], "the paper's Table 4");
         let rtol = &schema["$defs"]["SolverSettings"]["properties"]["rtol"];
         assert_eq!(rtol["maximum"], 1e-2);
+        // The bearing analysis's fields carry theirs too, integers included.
+        let bearing = schema["$defs"]["BearingPair"]["properties"]
+            .as_object()
+            .unwrap();
+        let pair = serde_json::to_value(BearingPair::default()).unwrap();
+        for key in pair.as_object().unwrap().keys() {
+            let p = &bearing[key];
+            assert!(p.get("x-unit").is_some(), "bearing.{key}: no unit");
+            assert!(p.get("x-source").is_some(), "bearing.{key}: no source");
+            assert!(
+                p.get("minimum").is_some() || p.get("exclusiveMinimum").is_some(),
+                "bearing.{key}: no minimum"
+            );
+            assert!(
+                p.get("maximum").is_some() || p.get("exclusiveMaximum").is_some(),
+                "bearing.{key}: no maximum"
+            );
+        }
+        assert_eq!(bearing["balls_per_row"]["minimum"], 3.0);
+        assert_eq!(bearing["balls_per_row"]["maximum"], 1000.0);
+        assert_eq!(bearing["rows"]["minimum"], 1.0);
+        assert_eq!(bearing["young_modulus_pa"]["x-unit"], "Pa");
+        assert_eq!(bearing["lumped_stiffness_n_per_m1_5"]["x-unit"], "N/m^1.5");
+        assert_eq!(bearing["dynamic_rating_n"]["x-source"], "ISO 281");
+        assert_eq!(
+            bearing["ball_diameter_m"]["x-source"],
+            "the paper's Table 3"
+        );
+        // Every bearing field is probed by the range test.
+        for key in pair.as_object().unwrap().keys() {
+            let dotted = format!("bearing.{key}");
+            assert!(
+                FIELD_RANGES.iter().any(|r| r.key == dotted),
+                "{dotted} has no range"
+            );
+        }
     }
 }

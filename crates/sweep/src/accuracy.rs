@@ -192,6 +192,13 @@ impl AccuracySpec {
                 )?;
             }
         }
+        if self.cases.is_empty() {
+            return Err(AccuracySpecError::Range {
+                field: "cases".into(),
+                value: "[]".into(),
+                allowed: "at least one case".into(),
+            });
+        }
         for (i, c) in self.cases.iter().enumerate() {
             let s = self.case_scene(i)?;
             s.validate().map_err(|e| AccuracySpecError::Range {
@@ -631,5 +638,11 @@ mod tests {
         let spec: AccuracySpec =
             serde_json::from_str(r#"{"rtol": [0.5], "cases": [], "settings": []}"#).unwrap();
         assert!(spec.validate().unwrap_err().to_string().contains("rtol[0]"));
+        let spec: AccuracySpec =
+            serde_json::from_str(r#"{"rtol": [1e-4], "cases": [], "settings": []}"#).unwrap();
+        assert_eq!(
+            spec.validate().unwrap_err().to_string(),
+            "cases = []: allowed at least one case"
+        );
     }
 }

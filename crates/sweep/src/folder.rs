@@ -291,11 +291,16 @@ impl RunFolder {
         match mode {
             Mode::Fresh => Err(SweepError::Refused(format!(
                 "{} holds the results of another run ({}; {}): a results folder is one run's \
-                 record. Use --resume to continue that run (the same spec), --overwrite to \
-                 replace it, or choose another --out",
+                 record. Use {}--overwrite to replace it, or choose another --out",
                 dir.display(),
                 present.join(", "),
-                describe_manifest(dir)
+                describe_manifest(dir),
+                // `merge` writes its folder whole: it has no --resume.
+                if what == "merge" {
+                    ""
+                } else {
+                    "--resume to continue that run (the same spec), "
+                }
             ))),
             Mode::Resume => {
                 check_resumable(dir, id)?;

@@ -149,10 +149,15 @@ pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), Overri
         // An optional section that is absent (e.g. `thermal` on a drop without it) has no
         // sub-keys to set: say so instead of failing deeper.
         let Some(next) = obj.get_mut(*part) else {
+            // `whirlmap drop` has a flag that switches each optional section on.
+            let flag = match *part {
+                "thermal" | "bearing" => format!(", or pass --{part} to `whirlmap drop`"),
+                _ => String::new(),
+            };
             return Err(OverrideError::UnknownKey {
                 key: key.to_string(),
                 suggestion: None,
-                known: format!("none (`{part}` is not set in this scene: set it whole first, e.g. `--set {part}={{}}`, or use --thermal)"),
+                known: format!("none (`{part}` is not set in this scene: set it whole first, e.g. `--set {part}={{}}`{flag})"),
             });
         };
         node = next;
@@ -200,7 +205,15 @@ mod tests {
         apply_assignment(&mut s, "quasi_static_race=true").unwrap();
         assert!(s.quasi_static_race);
         let err = apply_assignment(&mut s, "thermal.macro_step_s=0.01").unwrap_err();
-        assert!(err.to_string().contains("thermal"), "{err}");
+        assert!(err.to_string().contains("pass --thermal"), "{err}");
+        // Each section's hint names its own flag.
+        let err = apply_assignment(&mut s, "bearing.rows=3").unwrap_err();
+        assert!(
+            err.to_string().contains("--set bearing={}")
+                && err.to_string().contains("pass --bearing")
+                && !err.to_string().contains("--thermal"),
+            "{err}"
+        );
         apply_assignment(&mut s, "thermal={}").unwrap();
         apply_assignment(&mut s, "thermal.macro_step_s=0.002").unwrap();
         assert_eq!(s.thermal.as_ref().unwrap().macro_step_s, 0.002);

@@ -26,6 +26,7 @@
 
 use super::hertz::{series_stiffness_n_per_m1_5, PointContact, Race};
 use crate::error::InvalidParameter;
+use crate::scene::{approx, num};
 use serde::{Deserialize, Serialize};
 
 /// Harris's radial integral for zero clearance, `J_r(0.5) = (1/2π) ∫_{-π/2}^{π/2} cos^2.5 ψ
@@ -35,6 +36,24 @@ pub const RADIAL_INTEGRAL_ZERO_CLEARANCE: f64 = 0.228_827_929_050_544;
 /// ISO 76's limiting contact pressure for ball bearings other than self-aligning (Pa): the
 /// static load rating is the load that produces it at the most heavily loaded contact.
 pub const ISO76_BALL_LIMIT_PRESSURE_PA: f64 = 4.2e9;
+
+/// Allowed ball diameter (m): a tenth of a millimetre to 100 mm.
+pub const BALL_DIAMETER_RANGE_M: [f64; 2] = [1e-4, 0.1];
+/// Allowed pitch diameter (m): 1 mm to 10 m (the scene's own `pitch_diameter_m` is at most
+/// 10 m).
+pub const PITCH_DIAMETER_RANGE_M: [f64; 2] = [1e-3, 10.0];
+/// Allowed Young's modulus of balls and rings (Pa): polymers (about 1 GPa) to ceramics and
+/// carbides (silicon nitride 310 GPa, tungsten carbide about 700 GPa).
+pub const YOUNG_MODULUS_RANGE_PA: [f64; 2] = [1e9, 1e12];
+/// Allowed lumped stiffness (N/m^1.5): a force at 1 um of 1e-3 N to 1e10 N, the range the
+/// scene allows its race-on-balls support ([`crate::scene::SUPPORT_FORCE_AT_1UM_N`]).
+pub const LUMPED_STIFFNESS_RANGE_N_PER_M1_5: [f64; 2] = [1e6, 1e19];
+/// Allowed basic load ratings, dynamic and static (N): the scene's range for its static
+/// load rating (`static_load_rating_n`).
+pub const LOAD_RATING_RANGE_N: [f64; 2] = [1.0, 1e8];
+/// Allowed static limit on the contact pressure (Pa): 0.1 GPa to 10 GPa (ISO 76's is 4.2
+/// GPa for ball bearings, 4.0 GPa for roller bearings).
+pub const LIMIT_PRESSURE_RANGE_PA: [f64; 2] = [1e8, 1e10];
 
 /// ISO 281:2007's rating factor `b_m` for radial ball bearings (its Table 1).
 pub const ISO281_BM_RADIAL_BALL: f64 = 1.3;
@@ -78,46 +97,57 @@ pub fn iso281_fc(gamma: f64) -> Option<f64> {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BearingPair {
-    /// Ball diameter `D` (m). Default 5.5 mm \[Table 3\].
+    /// Ball diameter `D` (m). Default 5.5 mm \[Table 3\]. Allowed [1e-4, 0.1] m, and the
+    /// balls of one row must fit on the pitch circle without overlapping:
+    /// `balls_per_row * ball_diameter_m < pi * pitch_diameter_m`.
     pub ball_diameter_m: f64,
     /// Pitch diameter `d_m` (m). Default 51 mm, the mean of bore and outside diameter
-    /// \[Table 3\], as the scene's drag model takes it.
+    /// \[Table 3\], as the scene's drag model takes it. Allowed [1e-3, 10] m and larger than
+    /// `ball_diameter_m`.
     pub pitch_diameter_m: f64,
     /// Balls per row `Z`. Default 22: not in the paper or the catalogue tables; the pitch
     /// circle (π d_m = 160 mm) filled with 5.5 mm balls at the spacing of caged angular
     /// contact bearings (about 1.3 ball diameters), as the thermal model assumes
     /// (`thermal::params`). With it ISO 76 gives `C_0 = 10.4 kN` per bearing, matching the
-    /// 10 kN order of a 71908 catalogue entry the scene uses for the drag torque.
+    /// 10 kN order of a 71908 catalogue entry the scene uses for the drag torque. Allowed
+    /// [3, 1000], and the balls must fit on the pitch circle (see `ball_diameter_m`).
     pub balls_per_row: u32,
-    /// Rows `i`. Default 2: two 71908 CD face to face.
+    /// Rows `i`. Default 2: two 71908 CD face to face. Allowed [1, 8].
     pub rows: u32,
     /// Nominal contact angle `α` (rad). Default 15° (suffix CD \[SKF\]). Taken as constant:
     /// zero clearance and no axial load keep it at its nominal value (Harris ch. 7 for small
-    /// displacements).
+    /// displacements). Allowed [0, 1.4) rad (radial and angular contact).
     pub contact_angle_rad: f64,
     /// Inner groove conformity `f_i = r_i / D`. Default 0.52: ISO 281's and ISO 76's rating
-    /// basis (`r_i <= 0.52 D_w`), the usual value of angular contact ball bearings.
+    /// basis (`r_i <= 0.52 D_w`) \[ISO 281\], the usual value of angular contact ball
+    /// bearings. Allowed (0.5, 1).
     pub inner_conformity: f64,
     /// Outer groove conformity `f_o = r_o / D`. Default 0.53: ISO 281's and ISO 76's rating
-    /// basis (`r_e <= 0.53 D_w`).
+    /// basis (`r_e <= 0.53 D_w`) \[ISO 281\]. Allowed (0.5, 1).
     pub outer_conformity: f64,
     /// Young's modulus of balls and rings (Pa). Default 208e9, AISI 52100 \[Harris\].
+    /// Allowed [1e9, 1e12] Pa (polymers to ceramics).
     pub young_modulus_pa: f64,
-    /// Poisson's ratio of balls and rings. Default 0.3 \[Harris\].
+    /// Poisson's ratio of balls and rings. Default 0.3 \[Harris\]. Allowed [0, 0.5).
     pub poisson_ratio: f64,
     /// The lumped radial stiffness the dynamics use, `F = k2 r^1.5` (N/m^1.5). Default
     /// 7.811e9 \[Table 4\]. The per-ball stiffness follows from it
-    /// ([`BearingPair::ball_stiffness_from_lumped_n_per_m1_5`]).
+    /// ([`BearingPair::ball_stiffness_from_lumped_n_per_m1_5`]). Allowed [1e6, 1e19]
+    /// N/m^1.5: a force at 1 um of [1e-3, 1e10] N, the scene's range for the support
+    /// stiffness `support_stiffness_n_per_m_e`.
     pub lumped_stiffness_n_per_m1_5: f64,
-    /// Basic dynamic load rating `C` of the pair (N), the ISO 281 `C_r` with `i = 2`.
-    /// Default 19 470 N: ISO 281's formula for this geometry
-    /// ([`BearingPair::iso281_dynamic_rating_n`]); one row alone is 11 980 N.
+    /// Basic dynamic load rating `C` of the pair (N), the ISO 281 `C_r` with `i = 2`
+    /// \[ISO 281\]. Default 19 470 N: ISO 281's formula for this geometry
+    /// ([`BearingPair::iso281_dynamic_rating_n`]); one row alone is 11 980 N. Allowed
+    /// [1, 1e8] N, as the scene's `static_load_rating_n`.
     pub dynamic_rating_n: f64,
-    /// Basic static load rating `C_0` of the pair (N), ISO 76 with `i = 2`. Default
-    /// 20 740 N: ISO 76's definition for this geometry
-    /// ([`BearingPair::iso76_static_rating_n`]); one row alone is 10 370 N.
+    /// Basic static load rating `C_0` of the pair (N), ISO 76 with `i = 2` \[ISO 76\].
+    /// Default 20 740 N: ISO 76's definition for this geometry
+    /// ([`BearingPair::iso76_static_rating_n`]); one row alone is 10 370 N. Allowed
+    /// [1, 1e8] N.
     pub static_rating_n: f64,
     /// The static limit on the maximum contact pressure (Pa). Default 4.2e9 \[ISO 76\].
+    /// Allowed [1e8, 1e10] Pa.
     pub static_limit_pressure_pa: f64,
 }
 
@@ -148,64 +178,128 @@ impl BearingPair {
         }
     }
 
-    /// Checks every field; the error names the first bad one.
+    /// Checks every field against its own allowed range ([`BearingPair::validate_fields`]),
+    /// then the geometry: the ball is smaller than the pitch diameter, and the balls of one
+    /// row fit on the pitch circle without overlapping,
+    /// `balls_per_row * ball_diameter_m < pi * pitch_diameter_m`. The error names the first
+    /// bad field by its dotted key in the scene (`bearing.rows`), with its value and the
+    /// allowed range.
     pub fn validate(&self) -> Result<(), InvalidParameter> {
-        let pos = |name: &str, v: f64| {
-            if v > 0.0 && v.is_finite() {
-                Ok(())
-            } else {
-                Err(InvalidParameter::new(name, v, "> 0 and finite"))
-            }
-        };
-        pos("ball_diameter_m", self.ball_diameter_m)?;
-        pos("pitch_diameter_m", self.pitch_diameter_m)?;
+        self.validate_fields()?;
         if !(self.ball_diameter_m < self.pitch_diameter_m) {
             return Err(InvalidParameter::new(
-                "ball_diameter_m",
-                self.ball_diameter_m,
-                "< pitch_diameter_m",
+                "bearing.pitch_diameter_m",
+                num(self.pitch_diameter_m),
+                &format!(
+                    "> bearing.ball_diameter_m = {} m (the balls' centres lie on the pitch \
+                     circle)",
+                    num(self.ball_diameter_m)
+                ),
             ));
         }
+        let z = self.balls_per_row as f64;
+        let circumference = std::f64::consts::PI * self.pitch_diameter_m;
+        if !(z * self.ball_diameter_m < circumference) {
+            return Err(InvalidParameter::new(
+                "bearing.ball_diameter_m",
+                num(self.ball_diameter_m),
+                &format!(
+                    "< pi * bearing.pitch_diameter_m / bearing.balls_per_row = pi * {} / {} = \
+                     {} m: the balls of one row must fit on the pitch circle without \
+                     overlapping (balls_per_row * ball_diameter_m < pi * pitch_diameter_m)",
+                    num(self.pitch_diameter_m),
+                    self.balls_per_row,
+                    approx(circumference / z)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks each field against its own allowed range (listed under `bearing.` in
+    /// [`crate::schema::FIELD_RANGES`]), not the geometry between fields
+    /// ([`BearingPair::validate`] adds it); the error names the field as `bearing.<field>`.
+    pub fn validate_fields(&self) -> Result<(), InvalidParameter> {
+        fn check(field: &str, v: f64, ok: bool, allowed: &str) -> Result<(), InvalidParameter> {
+            if v.is_finite() && ok {
+                Ok(())
+            } else {
+                Err(InvalidParameter::new(
+                    &format!("bearing.{field}"),
+                    num(v),
+                    allowed,
+                ))
+            }
+        }
+        let within = |v: f64, [lo, hi]: [f64; 2]| (lo..=hi).contains(&v);
+        check(
+            "ball_diameter_m",
+            self.ball_diameter_m,
+            within(self.ball_diameter_m, BALL_DIAMETER_RANGE_M),
+            "[1e-4, 0.1] m",
+        )?;
+        check(
+            "pitch_diameter_m",
+            self.pitch_diameter_m,
+            within(self.pitch_diameter_m, PITCH_DIAMETER_RANGE_M),
+            "[1e-3, 10] m",
+        )?;
         if !(3..=1000).contains(&self.balls_per_row) {
             return Err(InvalidParameter::new(
-                "balls_per_row",
+                "bearing.balls_per_row",
                 self.balls_per_row,
                 "[3, 1000]",
             ));
         }
         if !(1..=8).contains(&self.rows) {
-            return Err(InvalidParameter::new("rows", self.rows, "[1, 8]"));
+            return Err(InvalidParameter::new("bearing.rows", self.rows, "[1, 8]"));
         }
-        if !(self.contact_angle_rad >= 0.0 && self.contact_angle_rad < 1.4) {
-            return Err(InvalidParameter::new(
-                "contact_angle_rad",
-                self.contact_angle_rad,
-                "[0, 1.4) rad (radial and angular contact)",
-            ));
-        }
+        check(
+            "contact_angle_rad",
+            self.contact_angle_rad,
+            self.contact_angle_rad >= 0.0 && self.contact_angle_rad < 1.4,
+            "[0, 1.4) rad (radial and angular contact)",
+        )?;
         for (name, f) in [
             ("inner_conformity", self.inner_conformity),
             ("outer_conformity", self.outer_conformity),
         ] {
-            if !(f > 0.5 && f < 1.0) {
-                return Err(InvalidParameter::new(name, f, "(0.5, 1)"));
-            }
+            check(name, f, f > 0.5 && f < 1.0, "(0.5, 1)")?;
         }
-        pos("young_modulus_pa", self.young_modulus_pa)?;
-        if !(self.poisson_ratio >= 0.0 && self.poisson_ratio < 0.5) {
-            return Err(InvalidParameter::new(
-                "poisson_ratio",
-                self.poisson_ratio,
-                "[0, 0.5)",
-            ));
-        }
-        pos(
+        check(
+            "young_modulus_pa",
+            self.young_modulus_pa,
+            within(self.young_modulus_pa, YOUNG_MODULUS_RANGE_PA),
+            "[1e9, 1e12] Pa",
+        )?;
+        check(
+            "poisson_ratio",
+            self.poisson_ratio,
+            (0.0..0.5).contains(&self.poisson_ratio),
+            "[0, 0.5)",
+        )?;
+        check(
             "lumped_stiffness_n_per_m1_5",
             self.lumped_stiffness_n_per_m1_5,
+            within(
+                self.lumped_stiffness_n_per_m1_5,
+                LUMPED_STIFFNESS_RANGE_N_PER_M1_5,
+            ),
+            "[1e6, 1e19] N/m^1.5 (a force at 1 um of [1e-3, 1e10] N, the scene's range for \
+             support_stiffness_n_per_m_e)",
         )?;
-        pos("dynamic_rating_n", self.dynamic_rating_n)?;
-        pos("static_rating_n", self.static_rating_n)?;
-        pos("static_limit_pressure_pa", self.static_limit_pressure_pa)?;
+        for (name, v) in [
+            ("dynamic_rating_n", self.dynamic_rating_n),
+            ("static_rating_n", self.static_rating_n),
+        ] {
+            check(name, v, within(v, LOAD_RATING_RANGE_N), "[1, 1e8] N")?;
+        }
+        check(
+            "static_limit_pressure_pa",
+            self.static_limit_pressure_pa,
+            within(self.static_limit_pressure_pa, LIMIT_PRESSURE_RANGE_PA),
+            "[1e8, 1e10] Pa",
+        )?;
         Ok(())
     }
 
@@ -354,11 +448,121 @@ mod tests {
             inner_conformity: 0.5,
             ..BearingPair::default()
         };
-        assert_eq!(p.validate().unwrap_err().field, "inner_conformity");
+        assert_eq!(p.validate().unwrap_err().field, "bearing.inner_conformity");
         let p = BearingPair {
             balls_per_row: 2,
             ..BearingPair::default()
         };
-        assert_eq!(p.validate().unwrap_err().field, "balls_per_row");
+        assert_eq!(p.validate().unwrap_err().field, "bearing.balls_per_row");
+    }
+
+    #[test]
+    fn every_field_has_a_range_and_the_messages_name_the_dotted_field() {
+        let d = BearingPair::default();
+        let rows = BearingPair {
+            rows: 0,
+            ..d.clone()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(rows.to_string(), "invalid bearing.rows = 0: allowed [1, 8]");
+        // Ratings that make the damage infinite are refused.
+        for (p, field) in [
+            (
+                BearingPair {
+                    dynamic_rating_n: 1e-300,
+                    ..d.clone()
+                },
+                "bearing.dynamic_rating_n",
+            ),
+            (
+                BearingPair {
+                    static_rating_n: 1e300,
+                    ..d.clone()
+                },
+                "bearing.static_rating_n",
+            ),
+            (
+                BearingPair {
+                    static_limit_pressure_pa: 1.0,
+                    ..d.clone()
+                },
+                "bearing.static_limit_pressure_pa",
+            ),
+            (
+                BearingPair {
+                    young_modulus_pa: 1e-300,
+                    ..d.clone()
+                },
+                "bearing.young_modulus_pa",
+            ),
+            (
+                BearingPair {
+                    lumped_stiffness_n_per_m1_5: 1e-300,
+                    ..d.clone()
+                },
+                "bearing.lumped_stiffness_n_per_m1_5",
+            ),
+        ] {
+            let e = p.validate().unwrap_err();
+            assert_eq!(e.field, field, "{e}");
+            assert!(e.to_string().contains("allowed ["), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_ball_and_the_pitch_circle_are_named_together() {
+        let d = BearingPair::default();
+        let e = BearingPair {
+            pitch_diameter_m: 0.001,
+            ..d.clone()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "invalid bearing.pitch_diameter_m = 0.001: allowed > bearing.ball_diameter_m = \
+             0.0055 m (the balls' centres lie on the pitch circle)"
+        );
+    }
+
+    #[test]
+    fn the_balls_of_a_row_must_fit_on_the_pitch_circle() {
+        let d = BearingPair::default();
+        // 22 balls of 50 mm on a 51 mm pitch circle (160 mm round).
+        let big = BearingPair {
+            ball_diameter_m: 0.05,
+            ..d.clone()
+        };
+        let e = big.validate().unwrap_err();
+        assert_eq!(e.field, "bearing.ball_diameter_m", "{e}");
+        let text = e.to_string();
+        assert!(
+            text.contains("= 0.05:")
+                && text.contains("pi * 0.051 / 22 = 0.00728 m")
+                && text.contains("balls_per_row * ball_diameter_m < pi * pitch_diameter_m"),
+            "{text}"
+        );
+        // 200 balls of 10 mm.
+        let many = BearingPair {
+            balls_per_row: 200,
+            ball_diameter_m: 0.01,
+            ..d.clone()
+        };
+        let e = many.validate().unwrap_err().to_string();
+        assert!(e.contains("pi * 0.051 / 200"), "{e}");
+        // Just fitting is allowed: 29 balls of 5.5 mm take 159.5 mm of 160.2 mm.
+        BearingPair {
+            balls_per_row: 29,
+            ..d.clone()
+        }
+        .validate()
+        .unwrap();
+        BearingPair {
+            balls_per_row: 30,
+            ..d
+        }
+        .validate()
+        .unwrap_err();
     }
 }
