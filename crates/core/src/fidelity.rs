@@ -17,14 +17,15 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
     /// Screening: ROS34PW2 (linearly implicit, L-stable) with the free-flight gap bound and
-    /// the race's absolute tolerances x1000, at rtol 1e-4. About eight times cheaper than
-    /// `standard`, but outside the accuracy budget: on bouncing sequences its maximum force
-    /// is off by up to 12 % (docs/accuracy.md#fidelity-presets).
+    /// the race's absolute tolerances x1000, at rtol 1e-4. Cheaper than `standard`, but
+    /// outside the accuracy budget: on bouncing sequences its maximum force is off by up to
+    /// 12 % (docs/accuracy.md#fidelity-presets).
     Draft,
-    /// Design work, and the scene default: DOPRI5 at rtol 3e-5, the cheapest setting measured
-    /// within the budget (first and maximum contact force and peak heat power within 0.1 % of
-    /// `reference`, whirl frequency within 1 %, the same class away from a transition;
-    /// docs/accuracy.md#fidelity-presets).
+    /// Design work, and the scene default: RODAS4 on the full Jacobian at rtol 3e-5, with the
+    /// free-flight gap bound and the race's absolute tolerances x30; the cheapest setting
+    /// measured within the budget with its tolerance neighbours within it too (first and
+    /// maximum contact force and peak heat power within 0.1 % of `reference`, whirl frequency
+    /// within 1 %, the same class away from a transition; docs/accuracy.md#fidelity-presets).
     Standard,
     /// DOPRI5 at rtol 1e-9: the reference of the accuracy and convergence studies (DOP853 at
     /// rtol 1e-10 confirms it to 6e-6).

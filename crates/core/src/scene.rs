@@ -32,9 +32,8 @@ pub enum FrictionLaw {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
-    /// Dormand-Prince 5(4) with 4th-order dense output: the pair of the `standard` (the
-    /// scene default) and `reference` fidelities.
-    #[default]
+    /// Dormand-Prince 5(4) with 4th-order dense output: the pair of the `reference`
+    /// fidelity.
     Dopri5,
     /// Hairer's DOP853, 8(5,3) with 7th-order dense output: the independent reference of
     /// `whirlmap accuracy` (see `ode/dop853.rs` for why it is hand-written).
@@ -43,8 +42,10 @@ pub enum Method {
     /// 2005) with an analytic stiff Jacobian: its step is not bounded by the light race's
     /// contact mode (`ode/rosw.rs`). The `draft` fidelity's.
     Ros34pw2,
-    /// RODAS4, a Rosenbrock method of order 4 (Hairer and Wanner) on the same stiff Jacobian
-    /// and factors as ROS34PW2 (`ode/rodas.rs`). In no fidelity preset.
+    /// RODAS4, a Rosenbrock method of order 4 (Hairer and Wanner) on the full Jacobian and
+    /// the factors of ROS34PW2 (`ode/rodas.rs`): the `standard` fidelity's (the scene
+    /// default).
+    #[default]
     Rodas4,
 }
 
@@ -91,14 +92,16 @@ pub struct SolverSettings {
     pub max_step_attempts: u64,
     /// Located mode switches before a typed budget error (chatter guard). Default 2 000 000.
     pub max_events: u64,
-    /// The integrator. Default `dopri5`, the explicit Dormand-Prince 5(4) pair (the
-    /// `standard` and `reference` fidelities'); `ros34pw2` is the linearly implicit
-    /// Rosenbrock-W method, whose step is not bounded by the light race's contact modes (the
-    /// `draft` fidelity's); `dop853` the independent reference of `whirlmap accuracy`.
+    /// The integrator. Default `rodas4`, the 4th-order Rosenbrock method on the model's full
+    /// Jacobian, whose step is not bounded by the light race's contact modes (the `standard`
+    /// fidelity's); `dopri5`, the explicit Dormand-Prince 5(4) pair (the `reference`
+    /// fidelity's); `ros34pw2`, the 3rd-order Rosenbrock-W method (the `draft` fidelity's);
+    /// `dop853` the independent reference of `whirlmap accuracy`.
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a
-    /// bound on the relative acceleration). Default false (true in the `draft` fidelity).
+    /// bound on the relative acceleration). Default true (the `standard` and `draft`
+    /// fidelities'; false in `reference`).
     pub free_flight_gap_bound: bool,
     /// Factor on the absolute tolerances of the race's translation (its centre's position
     /// and velocity). The race centre is a fast variable held by two stiff springs (its own
@@ -106,8 +109,8 @@ pub struct SolverSettings {
     /// (`support_damper = isotropic`, the default) and an L-stable stepper (`ros34pw2`) its
     /// local errors decay instead of accumulating, and the rotor's absolute tolerances
     /// (`rtol * position_scale_m` on positions, `rtol * sqrt(2 g s) / 100` on velocities)
-    /// would bound the implicit step in contact. Default 1; 1000 in the `draft` fidelity,
-    /// whose accuracy cost is measured by `whirlmap accuracy`
+    /// would bound the implicit step in contact. Default 30 (the `standard` fidelity); 1000
+    /// in `draft` and 1 in `reference`, whose accuracy cost is measured by `whirlmap accuracy`
     /// (docs/accuracy.md#the-races-absolute-tolerance). Allowed [1, 1e4].
     pub race_atol_scale: f64,
 }
@@ -115,9 +118,11 @@ pub struct SolverSettings {
 // Exact comparison on purpose: only the default is left out of the JSON.
 
 impl Default for SolverSettings {
-    /// The `standard` fidelity ([`crate::Fidelity::Standard`]): DOPRI5 at rtol 3e-5, the
-    /// cheapest setting measured within the accuracy budget on the main job's grid and on
-    /// cases with long bouncing sequences (docs/accuracy.md#fidelity-presets).
+    /// The `standard` fidelity ([`crate::Fidelity::Standard`]): RODAS4 at rtol 3e-5 with the
+    /// free-flight gap bound and the race's tolerance x30, the cheapest setting measured
+    /// within the accuracy budget with both its tolerance neighbours within it too, on the
+    /// main job's grid and on cases with long bouncing sequences
+    /// (docs/accuracy.md#fidelity-presets).
     fn default() -> Self {
         Self {
             rtol: 3e-5,
@@ -126,9 +131,9 @@ impl Default for SolverSettings {
             min_step_s: 1e-13,
             max_step_attempts: 20_000_000,
             max_events: 2_000_000,
-            method: Method::Dopri5,
-            free_flight_gap_bound: false,
-            race_atol_scale: 1.0,
+            method: Method::Rodas4,
+            free_flight_gap_bound: true,
+            race_atol_scale: 30.0,
         }
     }
 }

@@ -221,7 +221,7 @@ mod tests {
         for (key, value) in [
             ("support_damper", "\"radial_only\""),
             ("release_velocity_m_s", "[0, -1e-3]"),
-            ("solver.free_flight_gap_bound", "true"),
+            ("solver.free_flight_gap_bound", "false"),
             ("solver.race_atol_scale", "100"),
             ("solver.method", "ros34pw2"),
         ] {
