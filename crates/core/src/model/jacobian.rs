@@ -225,15 +225,15 @@ impl DropSystem {
             }
         }
         if self.series.is_none() && self.mode.support {
-            let b = Vector2::new(y[XB], y[YB]);
-            let r = b.norm();
-            if r > 0.0 {
-                let nb = b / r;
-                let vb = Vector2::new(y[VXB], y[VYB]);
-                let vn = vb.dot(&nb);
-                let pb = Matrix2::identity() - nb * nb.transpose();
-                let pv = pb * vb;
-                let kd = self.k2 * self.e2 * hertz::signed_pow(r, self.e2) / r;
+            if let Some(SupportGeometry {
+                r,
+                nb,
+                vn,
+                pb,
+                pv,
+                kd,
+            }) = self.support_geometry(y)
+            {
                 let fs = f.support_n;
                 // The support's force -F_s nb (eq. 7, radial) and its radial damper, over the
                 // race position and velocity; then the tangential damper -c2_t (v - nb (nb.v))
@@ -286,6 +286,30 @@ impl DropSystem {
         sj
     }
 
+    /// The ball support's geometry at `y` (eq. 7 with e = 3/2): `None` with the race at the
+    /// housing's centre, where its direction is undefined.
+    #[inline]
+    fn support_geometry(&self, y: &[f64; N]) -> Option<SupportGeometry> {
+        use ix::*;
+        let b = Vector2::new(y[XB], y[YB]);
+        let r = b.norm();
+        if r <= 0.0 {
+            return None;
+        }
+        let nb = b / r;
+        let vb = Vector2::new(y[VXB], y[VYB]);
+        let vn = vb.dot(&nb);
+        let pb = Matrix2::identity() - nb * nb.transpose();
+        Some(SupportGeometry {
+            r,
+            nb,
+            vn,
+            pb,
+            pv: pb * vb,
+            kd: self.k2 * self.e2 * hertz::signed_pow(r, self.e2) / r,
+        })
+    }
+
     /// The slopes of the sticking constraint's friction (eq. 9 held: `v_rel' = 0`). The slip
     /// acceleration is affine in `F_t`, `s(F_t) = s0 - K F_t` with the constant
     /// `K = 1/m_r + 1/m_b + r_r^2/J_r + r_b^2/J_b` (without unbalance), so `F_t = s0 / K` and
@@ -311,15 +335,15 @@ impl DropSystem {
         let (mut s_vec, mut ds_db, mut ds_dvb) =
             (Vector2::zeros(), Matrix2::zeros(), Matrix2::zeros());
         let (mut dfs_db, mut dfs_dvb) = (Vector2::zeros(), Vector2::zeros());
-        let b = Vector2::new(y[XB], y[YB]);
-        let r = b.norm();
-        if self.mode.support && r > 0.0 {
-            let nb = b / r;
-            let vb = Vector2::new(y[VXB], y[VYB]);
-            let vn = vb.dot(&nb);
-            let pb = Matrix2::identity() - nb * nb.transpose();
-            let pv = pb * vb;
-            let kd = self.k2 * self.e2 * hertz::signed_pow(r, self.e2) / r;
+        if let (true, Some(g)) = (self.mode.support, self.support_geometry(y)) {
+            let SupportGeometry {
+                r,
+                nb,
+                vn,
+                pb,
+                pv,
+                kd,
+            } = g;
             let fs = f.support_n;
             s_vec = -fs * nb - self.c2_t * pv;
             dfs_db = kd * nb + (self.c2 / r) * pv;
@@ -370,4 +394,17 @@ struct StickingSlopes {
     dwb: f64,
     qb: Vector2<f64>,
     vb: Vector2<f64>,
+}
+
+/// The ball support's geometry at one state: the race centre's distance `r` from the
+/// housing's centre (m), its direction `nb`, the race's radial speed `vn` (m/s), the projector
+/// `pb` across `nb`, the race's velocity across it `pv` (m/s), and the Hertz law's slope `kd`
+/// (N/m).
+struct SupportGeometry {
+    r: f64,
+    nb: Vector2<f64>,
+    vn: f64,
+    pb: Matrix2<f64>,
+    pv: Vector2<f64>,
+    kd: f64,
 }
