@@ -613,7 +613,9 @@ impl Monitor {
     fn record_orbit(&mut self, sys: &DropSystem, t: f64, y: &[f64; N], force: bool) {
         use crate::model::ix::*;
         if let Some(orbit) = &mut self.orbit {
-            if force || t - self.orbit_last_t >= self.orbit_dt {
+            // A forced sample (release, end) is skipped where a sample at that very time
+            // exists already (a run that ends on a step's end): times strictly increase.
+            if (force && t > self.orbit_last_t) || t - self.orbit_last_t >= self.orbit_dt {
                 let f = sys.forces(y);
                 orbit.samples.push(OrbitSample {
                     t_s: t,

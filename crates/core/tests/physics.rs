@@ -1205,3 +1205,27 @@ fn standard_numerics_keep_the_invariants() {
         );
     }
 }
+
+/// An orbit's sample times strictly increase, also where a run ends on a step's end and the
+/// final state is recorded (a whirl stopped by the whirl rule).
+#[test]
+fn orbit_sample_times_strictly_increase() {
+    for (speed, mu) in [(8000.0, 0.4), (8000.0, 0.1)] {
+        let o = DropOptions {
+            duration_s: 0.3,
+            orbit_points: Some(2000),
+            ..Default::default()
+        };
+        let r = simulate(&scene(speed, mu), &o).unwrap();
+        let orbit = r.orbit.expect("an orbit was asked for");
+        assert!(orbit.samples.len() > 100, "{} samples", orbit.samples.len());
+        for w in orbit.samples.windows(2) {
+            assert!(
+                w[1].t_s > w[0].t_s,
+                "{speed} r/min, mu {mu}: samples at {} then {}",
+                w[0].t_s,
+                w[1].t_s
+            );
+        }
+    }
+}
