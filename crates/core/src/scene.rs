@@ -315,6 +315,20 @@ pub const SUPPORT_FORCE_AT_1UM_N: [f64; 2] = [1e-3, 1e10];
 pub const MAX_DAMPING_N_S_PER_M: f64 = 1e8;
 
 /// A number as a person would write it in a message: `1e308` and `1e-300` rather than 309
+/// A field's own range check: `Ok` when `v` is finite and `ok`, otherwise the error naming
+/// `field`, the value (as [`num`] writes it) and `allowed`.
+pub(crate) fn check_field(
+    field: &str,
+    v: f64,
+    ok: bool,
+    allowed: &str,
+) -> Result<(), InvalidParameter> {
+    if v.is_finite() && ok {
+        Ok(())
+    } else {
+        Err(InvalidParameter::new(field, num(v), allowed))
+    }
+}
 /// digits, `0.15` as is.
 pub fn num(v: f64) -> String {
     let a = v.abs();
@@ -461,13 +475,7 @@ impl Scene {
     /// Checks each field of the scene (not of its thermal model) against its own allowed
     /// range ([`crate::schema::FIELD_RANGES`] lists them).
     pub fn validate_fields(&self) -> Result<(), InvalidParameter> {
-        fn check(field: &str, v: f64, ok: bool, allowed: &str) -> Result<(), InvalidParameter> {
-            if v.is_finite() && ok {
-                Ok(())
-            } else {
-                Err(InvalidParameter::new(field, num(v), allowed))
-            }
-        }
+        let check = check_field;
         let pos = "> 0 and finite";
         check(
             "speed_rpm",

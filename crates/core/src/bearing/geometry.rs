@@ -26,7 +26,7 @@
 
 use super::hertz::{series_stiffness_n_per_m1_5, PointContact, Race};
 use crate::error::InvalidParameter;
-use crate::scene::{approx, num};
+use crate::scene::{approx, check_field, num};
 use serde::{Deserialize, Serialize};
 
 /// Harris's radial integral for zero clearance, `J_r(0.5) = (1/2π) ∫_{-π/2}^{π/2} cos^2.5 ψ
@@ -220,17 +220,9 @@ impl BearingPair {
     /// [`crate::schema::FIELD_RANGES`]), not the geometry between fields
     /// ([`BearingPair::validate`] adds it); the error names the field as `bearing.<field>`.
     pub fn validate_fields(&self) -> Result<(), InvalidParameter> {
-        fn check(field: &str, v: f64, ok: bool, allowed: &str) -> Result<(), InvalidParameter> {
-            if v.is_finite() && ok {
-                Ok(())
-            } else {
-                Err(InvalidParameter::new(
-                    &format!("bearing.{field}"),
-                    num(v),
-                    allowed,
-                ))
-            }
-        }
+        let check = |field: &str, v: f64, ok: bool, allowed: &str| {
+            check_field(&format!("bearing.{field}"), v, ok, allowed)
+        };
         let within = |v: f64, [lo, hi]: [f64; 2]| (lo..=hi).contains(&v);
         check(
             "ball_diameter_m",

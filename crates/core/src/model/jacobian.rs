@@ -48,6 +48,12 @@ impl DropSystem {
         let j = &mut sj.jac;
         j.fixed_view_mut::<4, 4>(QR, VR).fill_with_identity();
         let f = self.forces(y);
+        // The drag's torque and slopes, once, for both places that read them (exact only).
+        let drag = if self.exact_jacobian {
+            self.drag_slopes(y, &f)
+        } else {
+            None
+        };
         // t = R n with R the quarter turn.
         let quarter = Matrix2::new(0.0, -1.0, 1.0, 0.0);
         if self.mode.contact && f.dist_m > 0.0 {
@@ -117,7 +123,7 @@ impl DropSystem {
                 }
                 FrictionSlopes::Constraint => {
                     if self.exact_jacobian && self.series.is_none() {
-                        let g = self.sticking_slopes(y, &f, w, rp, p);
+                        let g = self.sticking_slopes(y, &f, drag.as_ref(), w, rp, p);
                         (dft_dd, dft_dw, dft_dwb) = (g.dd, g.dw, g.dwb);
                         sticking = Some(g);
                     }
@@ -258,14 +264,17 @@ impl DropSystem {
                 }
             }
         }
-        if let (true, Some(p)) = (self.exact_jacobian, &self.drag) {
+        if let Some(DragSlopes {
+            m,
+            dm_dw,
+            dm_dload,
+            dir,
+            ddir,
+        }) = drag
+        {
             // The drag's power M |omega_b| (regularised: M dir(omega_b) omega_b), over the
             // race's spin and, through the Palmgren load, the support force's state.
             let wb = y[WB];
-            let load = f.support_n + self.thermal_load_n;
-            let m = p.torque_n_m(wb, load);
-            let (dm_dw, dm_dload) = p.torque_slopes(wb, load);
-            let (dir, ddir) = drag::direction_and_slope(wb, self.omega_eps);
             sj.quad[(DRAG, SB)] += dm_dw * dir * wb + m * (ddir * wb + dir);
             let scale = dm_dload * dir * wb;
             for (g, col) in dload.iter().zip([QR, VR, QB, VB]) {
@@ -284,6 +293,22 @@ impl DropSystem {
         // The accumulators' rows, for the method that needs them.
         sj.quad_len = if self.exact_jacobian { 5 } else { 0 };
         sj
+    }
+
+    /// The Palmgren drag's torque and slopes at `y` (eqs. 11-13): `None` without drag.
+    fn drag_slopes(&self, y: &[f64; N], f: &super::forces::Forces) -> Option<DragSlopes> {
+        let p = self.drag.as_ref()?;
+        let wb = y[ix::WB];
+        let load = f.support_n + self.thermal_load_n;
+        let (dm_dw, dm_dload) = p.torque_slopes(wb, load);
+        let (dir, ddir) = drag::direction_and_slope(wb, self.omega_eps);
+        Some(DragSlopes {
+            m: p.torque_n_m(wb, load),
+            dm_dw,
+            dm_dload,
+            dir,
+            ddir,
+        })
     }
 
     /// The ball support's geometry at `y` (eq. 7 with e = 3/2): `None` with the race at the
@@ -320,11 +345,11 @@ impl DropSystem {
         &self,
         y: &[f64; N],
         f: &super::forces::Forces,
+        drag: Option<&DragSlopes>,
         w: Vector2<f64>,
         rp: Matrix2<f64>,
         p: Matrix2<f64>,
     ) -> StickingSlopes {
-        use ix::*;
         let k = 1.0 / self.m_r
             + 1.0 / self.m_b
             + self.r_r * self.r_r / self.j_r
@@ -362,12 +387,14 @@ impl DropSystem {
             + (v_t * dd / (dist * dist)) * n;
         // -M_b r_b / J_b with M_b = -M dir(omega_b).
         let mut dwb = 0.0;
-        if let Some(pg) = &self.drag {
-            let wb = y[WB];
-            let load = f.support_n + self.thermal_load_n;
-            let m = pg.torque_n_m(wb, load);
-            let (dm_dw, dm_dload) = pg.torque_slopes(wb, load);
-            let (dir, ddir) = drag::direction_and_slope(wb, self.omega_eps);
+        if let Some(&DragSlopes {
+            m,
+            dm_dw,
+            dm_dload,
+            dir,
+            ddir,
+        }) = drag
+        {
             let c = self.r_b / self.j_b;
             dwb = c * (dm_dw * dir + m * ddir);
             qb += (c * dm_dload * dir) * dfs_db;
@@ -407,4 +434,16 @@ struct SupportGeometry {
     pb: Matrix2<f64>,
     pv: Vector2<f64>,
     kd: f64,
+}
+
+/// The Palmgren drag at one state: the torque's magnitude `m` (N m), its slopes in the race's
+/// spin `dm_dw` (N m s) and in the load `dm_dload` (m), and the direction factor `dir` with its
+/// slope `ddir` (s/rad).
+#[derive(Clone, Copy)]
+struct DragSlopes {
+    m: f64,
+    dm_dw: f64,
+    dm_dload: f64,
+    dir: f64,
+    ddir: f64,
 }
