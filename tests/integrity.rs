@@ -509,6 +509,8 @@ fn impossible_physics_is_refused_and_a_failed_energy_audit_fails_the_drop() {
         "--set",
         "solver.race_atol_scale=1",
         "--set",
+        "solver.race_velocity_atol_from_force=false",
+        "--set",
         "classification.max_extension_s=0",
         "--json",
     ]);

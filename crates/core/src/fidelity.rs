@@ -22,10 +22,11 @@ pub enum Fidelity {
     /// 12 % (docs/accuracy.md#fidelity-presets).
     Draft,
     /// Design work, and the scene default: RODAS4 on the full Jacobian at rtol 3e-5, with the
-    /// free-flight gap bound and the race's absolute tolerances x30; the cheapest setting
-    /// measured within the budget with its tolerance neighbours within it too (first and
-    /// maximum contact force and peak heat power within 0.1 % of `reference`, whirl frequency
-    /// within 1 %, the same class away from a transition; docs/accuracy.md#fidelity-presets).
+    /// free-flight gap bound and the race's velocity tolerance widened from the contact force
+    /// in contact (every other tolerance the rotor's); within the budget with its tolerance
+    /// neighbours within it too, with a margin of two on the worst case (first and maximum
+    /// contact force and peak heat power within 0.1 % of `reference`, whirl frequency within
+    /// 1 %, the same class away from a transition; docs/accuracy.md#fidelity-presets).
     Standard,
     /// DOPRI5 at rtol 1e-9: the reference of the accuracy and convergence studies (DOP853 at
     /// rtol 1e-10 confirms it to 6e-6).
@@ -67,6 +68,7 @@ impl Fidelity {
                 method: Method::Ros34pw2,
                 free_flight_gap_bound: true,
                 race_atol_scale: 1000.0,
+                race_velocity_atol_from_force: false,
                 ..standard
             },
             Fidelity::Standard => standard,
@@ -75,6 +77,7 @@ impl Fidelity {
                 method: Method::Dopri5,
                 free_flight_gap_bound: false,
                 race_atol_scale: 1.0,
+                race_velocity_atol_from_force: false,
                 ..standard
             },
         }
@@ -90,6 +93,7 @@ impl Fidelity {
         s.method = p.method;
         s.free_flight_gap_bound = p.free_flight_gap_bound;
         s.race_atol_scale = p.race_atol_scale;
+        s.race_velocity_atol_from_force = p.race_velocity_atol_from_force;
         scene.quasi_static_race = false;
     }
 

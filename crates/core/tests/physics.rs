@@ -38,6 +38,7 @@ fn scene(speed_rpm: f64, mu: f64) -> Scene {
     s.solver.rtol = 1e-5;
     s.solver.free_flight_gap_bound = false;
     s.solver.race_atol_scale = 1.0;
+    s.solver.race_velocity_atol_from_force = false;
     s
 }
 

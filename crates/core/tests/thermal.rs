@@ -36,6 +36,7 @@ fn pin_dopri5(s: &mut Scene) {
     s.solver.rtol = 1e-5;
     s.solver.free_flight_gap_bound = false;
     s.solver.race_atol_scale = 1.0;
+    s.solver.race_velocity_atol_from_force = false;
 }
 
 /// The paper scene with the default thermal model, run for exactly the duration asked (the

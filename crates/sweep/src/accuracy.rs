@@ -104,6 +104,9 @@ fn default_reference_rtol() -> f64 {
 fn default_budget() -> u64 {
     4_000_000
 }
+fn default_perturbation() -> f64 {
+    1e-9
+}
 
 /// The whole study.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -124,6 +127,11 @@ pub struct AccuracySpec {
     /// waited for).
     #[serde(default = "default_budget")]
     pub max_step_attempts: u64,
+    /// How far the release point of each case's reference is moved, along x and then along
+    /// y, to measure how sensitive the outputs are to a physically negligible change (m).
+    /// Default 1e-9 (1 nm, about 1/150 000 of the paper's clearance); 0 skips it.
+    #[serde(default = "default_perturbation")]
+    pub release_perturbation_m: f64,
     /// The cases.
     pub cases: Vec<CaseSpec>,
     /// The settings.
@@ -162,6 +170,12 @@ impl AccuracySpec {
             self.duration_s,
             self.duration_s > 0.0 && self.duration_s <= 3600.0,
             "(0, 3600] s",
+        )?;
+        range(
+            "release_perturbation_m".into(),
+            self.release_perturbation_m,
+            (0.0..=1e-6).contains(&self.release_perturbation_m),
+            "[0, 1e-6] m",
         )?;
         range(
             "reference_rtol".into(),
@@ -373,6 +387,27 @@ pub struct Reference {
     pub dopri5: Result<Measured, String>,
     /// DOPRI5 against DOP853: the reference's own uncertainty.
     pub agreement: Option<Errors>,
+    /// The outputs' sensitivity: the largest change of each (the class: whether it holds)
+    /// when the reference's release point moves by the spec's `release_perturbation_m`
+    /// along x or along y. An error below it is below what the case's physics can resolve;
+    /// `None` when skipped or when a perturbed run failed.
+    #[serde(default)]
+    pub release_spread: Option<Errors>,
+}
+
+impl Errors {
+    /// The larger of each error of `self` and `other`; the class agrees only if it does in
+    /// both.
+    pub fn max(&self, other: &Errors) -> Errors {
+        Errors {
+            first_force_rel: self.first_force_rel.max(other.first_force_rel),
+            max_force_rel: self.max_force_rel.max(other.max_force_rel),
+            peak_heat_rel: self.peak_heat_rel.max(other.peak_heat_rel),
+            whirl_frequency_abs_hz: self.whirl_frequency_abs_hz.max(other.whirl_frequency_abs_hz),
+            friction_heat_rel: self.friction_heat_rel.max(other.friction_heat_rel),
+            class_agrees: self.class_agrees && other.class_agrees,
+        }
+    }
 }
 
 /// Everything the study produced.
@@ -392,10 +427,13 @@ pub fn run(spec: &AccuracySpec) -> Result<Study, AccuracySpecError> {
     for (i, c) in spec.cases.iter().enumerate() {
         let mut s = spec.case_scene(i)?;
         s.solver.rtol = spec.reference_rtol;
+        // Every tolerance at the reference's own: no velocity widened from the force.
+        s.solver.race_velocity_atol_from_force = false;
         s.solver.max_step_attempts = s.solver.max_step_attempts.max(50_000_000);
         let d = c.duration_s.unwrap_or(spec.duration_s);
         ref_jobs.push((c.name.clone(), s, d));
     }
+    let p = spec.release_perturbation_m;
     let references: Vec<Result<Reference, String>> = ref_jobs
         .par_iter()
         .map(|(name, s, d)| {
@@ -405,11 +443,26 @@ pub fn run(spec: &AccuracySpec) -> Result<Study, AccuracySpecError> {
                 .map_err(|e| format!("reference of case {name} failed: {e}"))?;
             let dopri5 = measure(s, *d, false);
             let agreement = dopri5.as_ref().ok().map(|m| Errors::of(m, &dop853));
+            let release_spread = if p > 0.0 {
+                [[p, 0.0], [0.0, p]]
+                    .iter()
+                    .map(|dxy| {
+                        let mut sp = s8.clone();
+                        sp.release_offset_m[0] += dxy[0];
+                        sp.release_offset_m[1] += dxy[1];
+                        measure(&sp, *d, false).ok().map(|m| Errors::of(&m, &dop853))
+                    })
+                    .reduce(|a, b| a.zip(b).map(|(a, b)| a.max(&b)))
+                    .flatten()
+            } else {
+                None
+            };
             Ok(Reference {
                 case: name.clone(),
                 dop853,
                 dopri5,
                 agreement,
+                release_spread,
             })
         })
         .collect();
@@ -518,12 +571,18 @@ fn pct(x: f64) -> String {
 pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
     let mut out = format!(
         "# Work-precision study `{}`\n\nReference: the full model, DOP853 at rtol {:e}; DOPRI5 at the same \
-         tolerance confirms it (the last columns: its relative differences, the reference's own \
-         uncertainty). Errors are relative (forces, heat power, friction heat over the drop) or \
+         tolerance confirms it (its relative differences: the reference's own uncertainty). The last \
+         column moves the reference's release point by a physically negligible distance, along x \
+         and then along y, and gives the largest change of each output: how well the case's \
+         physics determines it. An error below that change is below what any solver can be held \
+         to. Errors are relative (forces, heat power, friction heat over the drop) or \
          absolute (whirl frequency, Hz); cost is RHS evaluations, steps and wall time on one thread of this machine.\n\n",
         spec.name, spec.reference_rtol
     );
-    out.push_str("| case | class | first force (N) | max force (N) | peak heat (W) | whirl (Hz) | friction heat (J) | DOP853 RHS evals | DOPRI5 class | DOPRI5 diff first / max / heat / friction heat |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str(&format!(
+        "| case | class | first force (N) | max force (N) | peak heat (W) | whirl (Hz) | friction heat (J) | DOP853 RHS evals | DOPRI5 class | DOPRI5 diff first / max / heat / friction heat | release moved {:e} m: change first / max / heat / friction heat |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        spec.release_perturbation_m
+    ));
     for r in &study.references {
         let m = &r.dop853;
         let (c5, diff) = match (&r.dopri5, &r.agreement) {
@@ -540,8 +599,23 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
             (Err(e), _) => (format!("failed: {e}"), String::new()),
             _ => (String::new(), String::new()),
         };
+        let spread = match &r.release_spread {
+            Some(a) => format!(
+                "{} / {} / {} / {}{}",
+                pct(a.first_force_rel),
+                pct(a.max_force_rel),
+                pct(a.peak_heat_rel),
+                pct(a.friction_heat_rel),
+                if a.class_agrees {
+                    ""
+                } else {
+                    " (class changes)"
+                }
+            ),
+            None => "not measured".into(),
+        };
         out.push_str(&format!(
-            "| {} | {} | {:.2} | {:.2} | {:.1} | {:.3} | {:.4} | {} | {} | {} |\n",
+            "| {} | {} | {:.2} | {:.2} | {:.1} | {:.3} | {:.4} | {} | {} | {} | {} |\n",
             r.case,
             m.class.name(),
             m.first_contact_force_n,
@@ -551,7 +625,8 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
             m.friction_heat_j,
             m.rhs_evals,
             c5,
-            diff
+            diff,
+            spread
         ));
     }
     for reference in &study.references {

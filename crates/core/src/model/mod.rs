@@ -75,6 +75,9 @@ pub struct DropSystem {
     pub thermal_load_n: f64,
     /// The last two evaluations of [`DropSystem::forces`], see [`ForceCache`].
     cache: RefCell<ForceCache>,
+    /// `solver.rtol` when `solver.race_velocity_atol_from_force` is on (the race's velocity
+    /// tolerance is then widened to `rtol F_n / c1` in contact), else 0.
+    force_rtol: f64,
 }
 
 impl DropSystem {
@@ -132,6 +135,11 @@ impl DropSystem {
             },
             thermal_load_n: 0.0,
             cache: RefCell::new(ForceCache::default()),
+            force_rtol: if scene.solver.race_velocity_atol_from_force {
+                scene.solver.rtol
+            } else {
+                0.0
+            },
         }
     }
 
@@ -214,6 +222,28 @@ impl OdeSystem<N> for DropSystem {
         let a = 2.0 * a_rel + self.g + self.e * y[ix::WR] * y[ix::WR];
         let t_close = 2.0 * gap / (w + (w * w + 2.0 * a * gap).sqrt());
         cap.max(0.25 * t_close)
+    }
+
+    /// With `solver.race_velocity_atol_from_force`, while the contact carries load: the
+    /// race's velocity tolerances widened (never narrowed) to `rtol F_n / c1`, `F_n` the
+    /// contact force at the step's start (eq. 7). The race's velocity enters what the rotor
+    /// feels through the contact damper's term `c1 delta_dot` of eq. 7 (and, through the race's
+    /// momentum, m_b/m_r of the rotor's), so an error of that size moves the contact force by
+    /// at most `rtol` of itself. As the force falls towards a lift-off the tolerance tightens
+    /// back to the base, so the separation time keeps its accuracy.
+    /// docs/accuracy.md#the-races-velocity-tolerance-in-contact.
+    fn loosened_atol(&self, _t: f64, y: &[f64; N], base: &[f64; N]) -> Option<[f64; N]> {
+        if self.force_rtol == 0.0 || !self.mode.contact || self.c1 <= 0.0 {
+            return None;
+        }
+        let wide = self.force_rtol * self.with_forces(y, |f| f.normal_n) / self.c1;
+        if !(wide > base[ix::VXB].min(base[ix::VYB])) {
+            return None;
+        }
+        let mut atol = *base;
+        atol[ix::VXB] = atol[ix::VXB].max(wide);
+        atol[ix::VYB] = atol[ix::VYB].max(wide);
+        Some(atol)
     }
 
     fn max_step(&self) -> f64 {

@@ -79,6 +79,14 @@ impl<const N: usize> StepCore<N> {
         }
     }
 
+    /// The absolute tolerances of a step from `t`: the system's loosened ones
+    /// ([`OdeSystem::loosened_atol`]) or the stepper's own.
+    #[inline]
+    pub(super) fn atol_at<S: OdeSystem<N>>(&self, sys: &S, t: f64, y: &[f64; N]) -> [f64; N] {
+        sys.loosened_atol(t, y, &self.ctl.atol)
+            .unwrap_or(self.ctl.atol)
+    }
+
     /// Cuts the last accepted step at `t_cut` and returns its interpolant.
     pub(super) fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
         self.dense.t_end = t_cut;

@@ -259,8 +259,9 @@ impl<const N: usize> Dop853<N> {
         k[S] = kn;
         core.stats.rhs_evals += S as u64;
         let (mut err5, mut err3) = (0.0, 0.0);
+        let atol = core.atol_at(sys, t, y);
         for i in 0..N {
-            let sc = core.ctl.atol[i] + core.ctl.rtol * y[i].abs().max(y_new[i].abs());
+            let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y_new[i].abs());
             let mut e5 = 0.0;
             let mut b8 = 0.0;
             for j in 0..S {

@@ -155,9 +155,10 @@ fn attempt<S: OdeSystem<N>, const N: usize>(
     sys.rhs(t + h, y_new, k7);
     core.stats.rhs_evals += 6;
     let mut acc = 0.0;
+    let atol = core.atol_at(sys, t, y);
     for i in 0..N {
         let e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
-        let sc = core.ctl.atol[i] + core.ctl.rtol * y[i].abs().max(y_new[i].abs());
+        let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y_new[i].abs());
         acc += (e / sc) * (e / sc);
     }
     (acc / N as f64).sqrt()

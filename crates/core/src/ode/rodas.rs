@@ -179,9 +179,10 @@ impl<const N: usize> Rodas4<N> {
         core.stats.rhs_evals += 5;
         let mut y1 = [0.0; N];
         let mut err = 0.0;
+        let atol = core.atol_at(sys, t, y);
         for i in 0..N {
             y1[i] = yt[i] + u[5][i];
-            let sc = core.ctl.atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());
+            let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());
             err += (u[5][i] / sc) * (u[5][i] / sc);
         }
         (y1, (err / N as f64).sqrt())

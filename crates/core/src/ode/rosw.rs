@@ -405,8 +405,9 @@ impl<const N: usize> Ros34pw2<N> {
         // `W^-1` damps exactly those and leaves the non-stiff ones as they are.
         lu.solve(&mut e);
         let mut err = 0.0;
+        let atol = core.atol_at(sys, t, y);
         for i in 0..N {
-            let sc = core.ctl.atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());
+            let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());
             err += (e[i] / sc) * (e[i] / sc);
         }
         (y1, (err / N as f64).sqrt())
