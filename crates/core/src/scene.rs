@@ -116,8 +116,8 @@ pub struct SolverSettings {
     /// Allowed [1, 1e4].
     pub race_atol_scale: f64,
     /// While the rotor-race contact carries load, widen the absolute tolerance of the race's
-    /// velocity (never narrow it) to `rtol F_n / c1`: the race's velocity enters the contact
-    /// force only through the contact damper's term `c1 delta_dot` of eq. 7, so an error of
+    /// velocity (never narrow it) to `rtol F_n / c1`: the race's velocity enters the normal
+    /// contact force only through the contact damper's term `c1 delta_dot` of eq. 7, so an error of
     /// that size moves the force by at most `rtol` of itself, and the tolerance tightens
     /// again as the force falls towards a lift-off. The race's velocity is a fast variable
     /// there, whose error in an L-stable step spanning its modes would otherwise set the
