@@ -40,7 +40,9 @@ fn only_the_race_velocity_is_widened_and_only_as_far_as_the_contact_force_allows
     let (sys, y) = pressed(&s, 2e-6);
     let f_n = sys.forces(&y).normal_n;
     assert!(f_n > 500.0, "{f_n}");
-    let wide = sys.loosened_atol(0.0, &y, &base).expect("widened in contact");
+    let wide = sys
+        .loosened_atol(0.0, &y, &base)
+        .expect("widened in contact");
     for i in 0..N {
         let expected = if i == ix::VXB || i == ix::VYB {
             rtol * f_n / c1
@@ -107,7 +109,10 @@ fn the_widened_tolerance_keeps_the_budget_and_takes_fewer_steps() {
             assert_eq!(r.verdict.class, reference.verdict.class, "mu {mu} {on}");
             if g.whirl_frequency_hz.abs() > 10.0 {
                 let e = rel(f.whirl_frequency_hz, g.whirl_frequency_hz);
-                assert!(e < 1e-2, "mu {mu} option {on}: whirl frequency off by {e:e}");
+                assert!(
+                    e < 1e-2,
+                    "mu {mu} option {on}: whirl frequency off by {e:e}"
+                );
             }
             steps.push(r.stats.steps);
         }

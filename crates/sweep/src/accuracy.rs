@@ -403,7 +403,9 @@ impl Errors {
             first_force_rel: self.first_force_rel.max(other.first_force_rel),
             max_force_rel: self.max_force_rel.max(other.max_force_rel),
             peak_heat_rel: self.peak_heat_rel.max(other.peak_heat_rel),
-            whirl_frequency_abs_hz: self.whirl_frequency_abs_hz.max(other.whirl_frequency_abs_hz),
+            whirl_frequency_abs_hz: self
+                .whirl_frequency_abs_hz
+                .max(other.whirl_frequency_abs_hz),
             friction_heat_rel: self.friction_heat_rel.max(other.friction_heat_rel),
             class_agrees: self.class_agrees && other.class_agrees,
         }
@@ -450,7 +452,9 @@ pub fn run(spec: &AccuracySpec) -> Result<Study, AccuracySpecError> {
                         let mut sp = s8.clone();
                         sp.release_offset_m[0] += dxy[0];
                         sp.release_offset_m[1] += dxy[1];
-                        measure(&sp, *d, false).ok().map(|m| Errors::of(&m, &dop853))
+                        measure(&sp, *d, false)
+                            .ok()
+                            .map(|m| Errors::of(&m, &dop853))
                     })
                     .reduce(|a, b| a.zip(b).map(|(a, b)| a.max(&b)))
                     .flatten()
