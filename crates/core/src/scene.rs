@@ -121,8 +121,9 @@ pub struct SolverSettings {
     /// that size moves the force by at most `rtol` of itself, and the tolerance tightens
     /// again as the force falls towards a lift-off. The race's velocity is a fast variable
     /// there, whose error in an L-stable step spanning its modes would otherwise set the
-    /// step. Default true (the `standard` fidelity); false in `draft` and `reference`
-    /// (docs/accuracy.md#the-races-velocity-tolerance-in-contact).
+    /// step. Not applied with the `radial_only` support damper, which leaves the race's
+    /// tangential vibration undamped. Default true (the `standard` fidelity); false in
+    /// `draft` and `reference` (docs/accuracy.md#the-races-velocity-tolerance-in-contact).
     pub race_velocity_atol_from_force: bool,
 }
 

@@ -24,7 +24,8 @@ fn pressed(s: &Scene, delta_m: f64) -> (DropSystem, [f64; N]) {
 
 /// Free flight keeps the tolerances; a loaded contact widens exactly the race's two velocity
 /// components to `rtol F_n / c1`; a lightly loaded one, where that is below the base, keeps
-/// them (the tolerance is never narrowed); and with the option off nothing changes.
+/// them (the tolerance is never narrowed); with the option off or the radial-only support
+/// damper nothing changes.
 #[test]
 fn only_the_race_velocity_is_widened_and_only_as_far_as_the_contact_force_allows() {
     let s = Scene::paper();
@@ -63,6 +64,11 @@ fn only_the_race_velocity_is_widened_and_only_as_far_as_the_contact_force_allows
     off.solver.race_velocity_atol_from_force = false;
     let (sys, y) = pressed(&off, 2e-6);
     assert_eq!(sys.loosened_atol(0.0, &y, &base), None, "option off");
+    // The radial-only damper leaves the race's tangential vibration undamped: not widened.
+    let mut radial = s.clone();
+    radial.support_damper = whirlmap_core::SupportDamper::RadialOnly;
+    let (sys, y) = pressed(&radial, 2e-6);
+    assert_eq!(sys.loosened_atol(0.0, &y, &base), None, "radial-only damper");
     for f in [Fidelity::Draft, Fidelity::Reference] {
         assert!(!f.solver().race_velocity_atol_from_force, "{f}");
     }

@@ -75,8 +75,9 @@ pub struct DropSystem {
     pub thermal_load_n: f64,
     /// The last two evaluations of [`DropSystem::forces`], see [`ForceCache`].
     cache: RefCell<ForceCache>,
-    /// `solver.rtol` when `solver.race_velocity_atol_from_force` is on (the race's velocity
-    /// tolerance is then widened to `rtol F_n / c1` in contact), else 0.
+    /// `solver.rtol` when `solver.race_velocity_atol_from_force` is on and the support damps
+    /// the race in every direction (the race's velocity tolerance is then widened to
+    /// `rtol F_n / c1` in contact), else 0.
     force_rtol: f64,
 }
 
@@ -135,7 +136,12 @@ impl DropSystem {
             },
             thermal_load_n: 0.0,
             cache: RefCell::new(ForceCache::default()),
-            force_rtol: if scene.solver.race_velocity_atol_from_force {
+            // With the radial-only damper the race's tangential vibration is undamped: its
+            // velocity errors would not decay, so nothing is widened (measured: the radial-only
+            // study's maximum force missed the budget by 2.4e-3 with it).
+            force_rtol: if scene.solver.race_velocity_atol_from_force
+                && scene.support_damper == SupportDamper::Isotropic
+            {
                 scene.solver.rtol
             } else {
                 0.0
