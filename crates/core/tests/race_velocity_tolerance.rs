@@ -68,7 +68,11 @@ fn only_the_race_velocity_is_widened_and_only_as_far_as_the_contact_force_allows
     let mut radial = s.clone();
     radial.support_damper = whirlmap_core::SupportDamper::RadialOnly;
     let (sys, y) = pressed(&radial, 2e-6);
-    assert_eq!(sys.loosened_atol(0.0, &y, &base), None, "radial-only damper");
+    assert_eq!(
+        sys.loosened_atol(0.0, &y, &base),
+        None,
+        "radial-only damper"
+    );
     for f in [Fidelity::Draft, Fidelity::Reference] {
         assert!(!f.solver().race_velocity_atol_from_force, "{f}");
     }
