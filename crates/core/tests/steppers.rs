@@ -474,3 +474,92 @@ fn an_accumulators_row_gives_rodas4_its_order() {
         "ROS34PW2 without the row: order {w_method:.2}"
     );
 }
+
+/// The decay problem with a system that widens the first (faster) component's absolute
+/// tolerance a millionfold ([`OdeSystem::loosened_atol`]) and notes each time it is asked.
+struct Widening {
+    widen: bool,
+    asked: std::cell::RefCell<Vec<(f64, [f64; 2])>>,
+}
+impl OdeSystem<2> for Widening {
+    type Guard = NoGuard;
+    fn rhs(&self, t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+        Decay.rhs(t, y, dy)
+    }
+    fn stiff_jacobian(&self, t: f64, y: &[f64; 2]) -> Option<StiffJacobian> {
+        Decay.stiff_jacobian(t, y)
+    }
+    fn loosened_atol(&self, t: f64, y: &[f64; 2], base: &[f64; 2]) -> Option<[f64; 2]> {
+        self.asked.borrow_mut().push((t, *y));
+        self.widen.then(|| [base[0] * 1e6, base[1]])
+    }
+}
+
+/// Notes the start of every accepted step.
+struct Starts(Vec<(f64, [f64; 2])>);
+impl whirlmap_core::ode::Observer<Widening, 2> for Starts {
+    type Halt = std::convert::Infallible;
+    fn on_step(
+        &mut self,
+        _sys: &Widening,
+        step: &whirlmap_core::ode::StepView<'_, 2>,
+    ) -> std::ops::ControlFlow<Self::Halt> {
+        self.0
+            .push((step.dense.t0(), step.dense.eval(step.dense.t0())));
+        std::ops::ControlFlow::Continue(())
+    }
+}
+
+/// Every stepper asks the system for its tolerances exactly once per step, at the step's
+/// start (the state the step begins from, not a stage), and uses the answer: with the faster
+/// component's tolerance widened, its error no longer sets the step and the run takes fewer
+/// steps, while the slower component stays within its tolerance.
+#[test]
+fn every_stepper_asks_for_the_tolerances_at_each_steps_start_and_uses_them() {
+    fn run<M: Stepper<2>>(name: &str, make: impl Fn(StepControl<2>) -> M) {
+        let mut steps = [0; 2];
+        for widen in [false, true] {
+            let sys = Widening {
+                widen,
+                asked: Default::default(),
+            };
+            let ctl = StepControl {
+                rtol: 1e-8,
+                atol: [1e-8; 2],
+                h_min: 1e-14,
+                max_attempts: 1_000_000,
+                fixed_step: None,
+            };
+            let mut st = make(ctl);
+            let (mut t, mut y) = (0.0, [1.0, 1.0]);
+            let mut starts = Starts(Vec::new());
+            integrate(&sys, &mut st, &mut t, &mut y, 3.0, &mut starts).unwrap();
+            let asked = sys.asked.borrow();
+            assert_eq!(asked.len() as u64, st.stats().steps, "{name} widen {widen}");
+            assert_eq!(
+                *asked, starts.0,
+                "{name} widen {widen}: asked at the step starts"
+            );
+            let e1 = (y[1] - (-1.5f64).exp()).abs();
+            assert!(
+                e1 < 1e-6,
+                "{name} widen {widen}: second component off by {e1:e}"
+            );
+            steps[widen as usize] = st.stats().steps;
+        }
+        assert!(
+            steps[1] < steps[0],
+            "{name}: {} steps widened against {}",
+            steps[1],
+            steps[0]
+        );
+        eprintln!(
+            "{name}: {} steps, {} with the first component widened",
+            steps[0], steps[1]
+        );
+    }
+    run("DOPRI5", Dopri5::new);
+    run("DOP853", Dop853::new);
+    run("ROS34PW2", Ros34pw2::new);
+    run("RODAS4", Rodas4::new);
+}

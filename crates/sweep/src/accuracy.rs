@@ -235,6 +235,17 @@ impl AccuracySpec {
         Ok(())
     }
 
+    /// The scene of case `i`'s reference, DOPRI5's (DOP853 runs it with the method
+    /// switched): the case's scene at the `reference` preset's numerics (every tolerance the
+    /// rotor's, no gap bound), at `reference_rtol`, so a change of the scene defaults does
+    /// not move the reference.
+    pub fn reference_scene(&self, i: usize) -> Result<Scene, AccuracySpecError> {
+        let mut s = Fidelity::Reference.applied(&self.case_scene(i)?);
+        s.solver.rtol = self.reference_rtol;
+        s.solver.max_step_attempts = s.solver.max_step_attempts.max(50_000_000);
+        Ok(s)
+    }
+
     /// The scene of case `i` (paper scene plus the case's overrides).
     pub fn case_scene(&self, i: usize) -> Result<Scene, AccuracySpecError> {
         apply_map(
@@ -398,15 +409,24 @@ pub struct Reference {
 impl Errors {
     /// The larger of each error of `self` and `other`; the class agrees only if it does in
     /// both.
+    /// A NaN in either stays NaN.
     pub fn max(&self, other: &Errors) -> Errors {
+        let worst = |a: f64, b: f64| {
+            if a.is_nan() || b.is_nan() {
+                f64::NAN
+            } else {
+                a.max(b)
+            }
+        };
         Errors {
-            first_force_rel: self.first_force_rel.max(other.first_force_rel),
-            max_force_rel: self.max_force_rel.max(other.max_force_rel),
-            peak_heat_rel: self.peak_heat_rel.max(other.peak_heat_rel),
-            whirl_frequency_abs_hz: self
-                .whirl_frequency_abs_hz
-                .max(other.whirl_frequency_abs_hz),
-            friction_heat_rel: self.friction_heat_rel.max(other.friction_heat_rel),
+            first_force_rel: worst(self.first_force_rel, other.first_force_rel),
+            max_force_rel: worst(self.max_force_rel, other.max_force_rel),
+            peak_heat_rel: worst(self.peak_heat_rel, other.peak_heat_rel),
+            whirl_frequency_abs_hz: worst(
+                self.whirl_frequency_abs_hz,
+                other.whirl_frequency_abs_hz,
+            ),
+            friction_heat_rel: worst(self.friction_heat_rel, other.friction_heat_rel),
             class_agrees: self.class_agrees && other.class_agrees,
         }
     }
@@ -427,11 +447,7 @@ pub fn run(spec: &AccuracySpec) -> Result<Study, AccuracySpecError> {
     spec.validate()?;
     let mut ref_jobs = Vec::new();
     for (i, c) in spec.cases.iter().enumerate() {
-        let mut s = spec.case_scene(i)?;
-        s.solver.rtol = spec.reference_rtol;
-        // Every tolerance at the reference's own: no velocity widened from the force.
-        s.solver.race_velocity_atol_from_force = false;
-        s.solver.max_step_attempts = s.solver.max_step_attempts.max(50_000_000);
+        let s = spec.reference_scene(i)?;
         let d = c.duration_s.unwrap_or(spec.duration_s);
         ref_jobs.push((c.name.clone(), s, d));
     }
@@ -584,7 +600,7 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
         spec.name, spec.reference_rtol
     );
     out.push_str(&format!(
-        "| case | class | first force (N) | max force (N) | peak heat (W) | whirl (Hz) | friction heat (J) | DOP853 RHS evals | DOPRI5 class | DOPRI5 diff first / max / heat / friction heat | release moved {:e} m: change first / max / heat / friction heat |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| case | class | first force (N) | max force (N) | peak heat (W) | whirl (Hz) | friction heat (J) | DOP853 RHS evals | DOPRI5 class | DOPRI5 diff first / max / heat / friction heat | release moved {:e} m: change first / max / heat / friction heat / whirl (Hz) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         spec.release_perturbation_m
     ));
     for r in &study.references {
@@ -605,17 +621,19 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
         };
         let spread = match &r.release_spread {
             Some(a) => format!(
-                "{} / {} / {} / {}{}",
+                "{} / {} / {} / {} / {:.1e}{}",
                 pct(a.first_force_rel),
                 pct(a.max_force_rel),
                 pct(a.peak_heat_rel),
                 pct(a.friction_heat_rel),
+                a.whirl_frequency_abs_hz,
                 if a.class_agrees {
                     ""
                 } else {
                     " (class changes)"
                 }
             ),
+            None if spec.release_perturbation_m > 0.0 => "a moved run failed".into(),
             None => "not measured".into(),
         };
         out.push_str(&format!(
@@ -669,6 +687,44 @@ pub fn to_markdown(study: &Study, spec: &AccuracySpec) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_worst_of_two_errors_keeps_a_nan_and_a_class_change() {
+        let e = |x: f64, agrees: bool| Errors {
+            first_force_rel: x,
+            max_force_rel: 2.0 * x,
+            peak_heat_rel: x,
+            whirl_frequency_abs_hz: x,
+            friction_heat_rel: x,
+            class_agrees: agrees,
+        };
+        let m = e(1e-3, true).max(&e(2e-3, false));
+        assert_eq!((m.first_force_rel, m.max_force_rel), (2e-3, 4e-3));
+        assert!(!m.class_agrees);
+        let n = e(1e-3, true).max(&e(f64::NAN, true));
+        assert!(n.first_force_rel.is_nan() && n.friction_heat_rel.is_nan());
+    }
+
+    /// The reference runs at the `reference` preset's numerics whatever the scene defaults
+    /// and the case's own solver keys say, at the spec's tolerance.
+    #[test]
+    fn the_reference_is_the_reference_preset_at_the_spec_tolerance() {
+        let spec: AccuracySpec = serde_json::from_str(
+            r#"{"rtol": [1e-4], "reference_rtol": 1e-11, "settings": [],
+                "cases": [{"name": "c", "scene": {"mu_dynamic": 0.3,
+                           "solver.race_atol_scale": 300, "solver.method": "rodas4"}}]}"#,
+        )
+        .unwrap();
+        let s = spec.reference_scene(0).unwrap();
+        let mut expected = Fidelity::Reference.applied(&spec.case_scene(0).unwrap());
+        expected.solver.rtol = 1e-11;
+        expected.solver.max_step_attempts = 50_000_000;
+        assert_eq!(s, expected);
+        assert_eq!(s.mu_dynamic, 0.3);
+        assert_eq!(s.solver.race_atol_scale, 1.0);
+        assert!(!s.solver.race_velocity_atol_from_force && !s.solver.free_flight_gap_bound);
+        assert_eq!(s.solver.method, Method::Dopri5);
+    }
 
     #[test]
     fn errors_are_relative_and_class_is_compared() {

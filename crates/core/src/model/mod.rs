@@ -75,10 +75,10 @@ pub struct DropSystem {
     pub thermal_load_n: f64,
     /// The last two evaluations of [`DropSystem::forces`], see [`ForceCache`].
     cache: RefCell<ForceCache>,
-    /// `solver.rtol` when `solver.race_velocity_atol_from_force` is on and the support damps
-    /// the race in every direction (the race's velocity tolerance is then widened to
-    /// `rtol F_n / c1` in contact), else 0.
-    force_rtol: f64,
+    /// `solver.rtol` when the race's velocity tolerance is widened in contact
+    /// (`solver.race_velocity_atol_from_force` on, and both dampers acting: see
+    /// [`OdeSystem::loosened_atol`]), `None` otherwise.
+    widen_rtol: Option<f64>,
 }
 
 impl DropSystem {
@@ -136,16 +136,15 @@ impl DropSystem {
             },
             thermal_load_n: 0.0,
             cache: RefCell::new(ForceCache::default()),
-            // With the radial-only damper the race's tangential vibration is undamped: its
-            // velocity errors would not decay, so nothing is widened (measured: the radial-only
-            // study's maximum force missed the budget by 2.4e-3 with it).
-            force_rtol: if scene.solver.race_velocity_atol_from_force
+            // Without a damper on the race in every direction (the radial-only law, or c2 = 0)
+            // its vibration is undamped: its velocity errors would not decay, so nothing is
+            // widened (measured: the radial-only study's maximum force missed the budget by
+            // 2.4e-3 with it). Without a contact damper the argument has no force to hold.
+            widen_rtol: (scene.solver.race_velocity_atol_from_force
                 && scene.support_damper == SupportDamper::Isotropic
-            {
-                scene.solver.rtol
-            } else {
-                0.0
-            },
+                && scene.support_damping_n_s_per_m > 0.0
+                && scene.contact_damping_n_s_per_m > 0.0)
+                .then_some(scene.solver.rtol),
         }
     }
 
@@ -231,18 +230,20 @@ impl OdeSystem<N> for DropSystem {
     }
 
     /// With `solver.race_velocity_atol_from_force`, while the contact carries load: the
-    /// race's velocity tolerances widened (never narrowed) to `rtol F_n / c1`, `F_n` the
-    /// contact force at the step's start (eq. 7). The race's velocity enters what the rotor
-    /// feels through the contact damper's term `c1 delta_dot` of eq. 7 (and, through the race's
-    /// momentum, m_b/m_r of the rotor's), so an error of that size moves the contact force by
-    /// at most `rtol` of itself. As the force falls towards a lift-off the tolerance tightens
-    /// back to the base, so the separation time keeps its accuracy.
-    /// docs/accuracy.md#the-races-velocity-tolerance-in-contact.
+    /// race's velocity tolerances widened (never narrowed) to `rtol F_n / max(c1, c2)`,
+    /// `F_n` the contact force at the step's start (eq. 7). The race's velocity enters the
+    /// normal contact force only through the contact damper's term `c1 delta_dot` of eq. 7,
+    /// and the ball support force (about `F_n` in contact) through the support damper's
+    /// `c2`, so an error of that size moves either damper's force by at most `rtol F_n` (and
+    /// the rotor's trajectory, through the race's momentum, by m_b/m_r of what the same
+    /// error on the rotor would). As the force falls towards a lift-off the tolerance
+    /// tightens back to the base. docs/accuracy.md#the-races-velocity-tolerance-in-contact.
     fn loosened_atol(&self, _t: f64, y: &[f64; N], base: &[f64; N]) -> Option<[f64; N]> {
-        if self.force_rtol == 0.0 || !self.mode.contact || self.c1 <= 0.0 {
+        let rtol = self.widen_rtol?;
+        if !self.mode.contact {
             return None;
         }
-        let wide = self.force_rtol * self.with_forces(y, |f| f.normal_n) / self.c1;
+        let wide = rtol * self.with_forces(y, |f| f.normal_n) / self.c1.max(self.c2);
         if !(wide > base[ix::VXB].min(base[ix::VYB])) {
             return None;
         }

@@ -38,6 +38,8 @@ pub struct StepCore<const N: usize> {
     pub(super) err_old: f64,
     /// The interpolant of the last accepted step.
     pub(super) dense: Dense<N>,
+    /// The absolute tolerances of the current step ([`StepCore::begin_step`]).
+    pub(super) step_atol: [f64; N],
 }
 
 impl<const N: usize> StepCore<N> {
@@ -48,6 +50,7 @@ impl<const N: usize> StepCore<N> {
             stats: Stats::default(),
             h: 0.0,
             err_old: 1e-4,
+            step_atol: ctl.atol,
             dense: Dense {
                 t0: 0.0,
                 h: 1.0,
@@ -79,12 +82,15 @@ impl<const N: usize> StepCore<N> {
         }
     }
 
-    /// The absolute tolerances of a step from `t`: the system's loosened ones
-    /// ([`OdeSystem::loosened_atol`]) or the stepper's own.
+    /// Sets the absolute tolerances of the step from `(t, y)`, which every attempt of it
+    /// uses: the system's widened ones ([`OdeSystem::loosened_atol`]) or the stepper's own.
+    /// Asked once per step, before its attempts, while the state's model evaluation is
+    /// still at hand.
     #[inline]
-    pub(super) fn atol_at<S: OdeSystem<N>>(&self, sys: &S, t: f64, y: &[f64; N]) -> [f64; N] {
-        sys.loosened_atol(t, y, &self.ctl.atol)
-            .unwrap_or(self.ctl.atol)
+    pub(super) fn begin_step<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
+        self.step_atol = sys
+            .loosened_atol(t, y, &self.ctl.atol)
+            .unwrap_or(self.ctl.atol);
     }
 
     /// Cuts the last accepted step at `t_cut` and returns its interpolant.

@@ -259,7 +259,7 @@ impl<const N: usize> Dop853<N> {
         k[S] = kn;
         core.stats.rhs_evals += S as u64;
         let (mut err5, mut err3) = (0.0, 0.0);
-        let atol = core.atol_at(sys, t, y);
+        let atol = core.step_atol;
         for i in 0..N {
             let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y_new[i].abs());
             let mut e5 = 0.0;
@@ -339,6 +339,7 @@ impl<const N: usize> Stepper<N> for Dop853<N> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError> {
+        self.core.begin_step(sys, t, y);
         let k1 = &self.k1;
         let ((y_new, mut k), h) = self.core.control(&LAW, t, h_cap, |core, h| {
             Self::attempt(core, k1, sys, t, y, h)

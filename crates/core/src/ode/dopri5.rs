@@ -155,7 +155,7 @@ fn attempt<S: OdeSystem<N>, const N: usize>(
     sys.rhs(t + h, y_new, k7);
     core.stats.rhs_evals += 6;
     let mut acc = 0.0;
-    let atol = core.atol_at(sys, t, y);
+    let atol = core.step_atol;
     for i in 0..N {
         let e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
         let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y_new[i].abs());
@@ -176,6 +176,7 @@ impl<const N: usize> Stepper<N> for Dopri5<N> {
         y: &[f64; N],
         h_cap: f64,
     ) -> Result<&Dense<N>, SolveError> {
+        self.core.begin_step(sys, t, y);
         let (k1, trial) = (&self.k1, &mut self.trial);
         let ((), h) = self.core.control(&LAW, t, h_cap, |core, h| {
             ((), attempt(core, k1, trial, sys, t, y, h))

@@ -179,7 +179,7 @@ impl<const N: usize> Rodas4<N> {
         core.stats.rhs_evals += 5;
         let mut y1 = [0.0; N];
         let mut err = 0.0;
-        let atol = core.atol_at(sys, t, y);
+        let atol = core.step_atol;
         for i in 0..N {
             y1[i] = yt[i] + u[5][i];
             let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());

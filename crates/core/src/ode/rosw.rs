@@ -405,7 +405,7 @@ impl<const N: usize> Ros34pw2<N> {
         // `W^-1` damps exactly those and leaves the non-stiff ones as they are.
         lu.solve(&mut e);
         let mut err = 0.0;
-        let atol = core.atol_at(sys, t, y);
+        let atol = core.step_atol;
         for i in 0..N {
             let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());
             err += (e[i] / sc) * (e[i] / sc);
@@ -457,6 +457,7 @@ where
         lu.j.quad_len = 0;
     }
     core.stats.jacobians += 1;
+    core.begin_step(sys, t, y);
     let start = *f0;
     let (y1, h) = core.control(method.law, t, h_cap, |core, h| {
         core.stats.factorizations += 1;

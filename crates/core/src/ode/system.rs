@@ -118,9 +118,9 @@ pub trait OdeSystem<const N: usize> {
 
     /// The absolute tolerances of a step from `(t, y)`, when the system widens some
     /// components there (`base` is the stepper's own); `None`, the default, keeps `base`.
-    /// For a variable that matters only through a term whose own scale varies: the drop
-    /// model widens the race's velocity tolerance to what the contact force needs
-    /// (`solver.race_velocity_atol_from_force`).
+    /// Every stepper asks once per step, before its attempts, and uses the answer for all of
+    /// them. For a variable that matters only through terms whose own scale varies with the
+    /// state.
     fn loosened_atol(&self, _t: f64, _y: &[f64; N], _base: &[f64; N]) -> Option<[f64; N]> {
         None
     }
