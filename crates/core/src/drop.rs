@@ -20,8 +20,10 @@ use std::ops::ControlFlow;
 /// alters results for the same scene.
 ///
 /// - 7: the `standard` numerics widen the race's velocity tolerance in loaded contact to
-///   `rtol F_n / c1` (`solver.race_velocity_atol_from_force`), where the race's velocity
-///   had set RODAS4's step.
+///   `rtol F_n / max(c1, c2)` (`solver.race_velocity_atol_from_force`), where the race's
+///   velocity had set RODAS4's step, and hold every other race tolerance to the rotor's
+///   (`solver.race_atol_scale` default 1, was 30; with the radial-only damper, which widens
+///   nothing, that makes drops dearer and closer to `reference`).
 /// - 6: the `standard` numerics are RODAS4 on the model's full Jacobian (the accumulators'
 ///   rows, the sticking constraint's and the drag's slopes) at rtol 3e-5, with the
 ///   free-flight gap bound and the race tolerance x30: four times closer to `reference` than

@@ -84,8 +84,8 @@ impl Fidelity {
     }
 
     /// Sets the preset's numerics on `scene` (tolerance, integrator, gap bound, race
-    /// tolerance scale), and the full model (`quasi_static_race` off). The physics a user
-    /// chose stays as it is.
+    /// tolerance scale, the race's velocity tolerance from the force), and the full model
+    /// (`quasi_static_race` off). The physics a user chose stays as it is.
     pub fn apply(self, scene: &mut Scene) {
         let p = self.solver();
         let s = &mut scene.solver;

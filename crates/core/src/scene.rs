@@ -116,14 +116,15 @@ pub struct SolverSettings {
     /// Allowed [1, 1e4].
     pub race_atol_scale: f64,
     /// While the rotor-race contact carries load, widen the absolute tolerance of the race's
-    /// velocity (never narrow it) to `rtol F_n / c1`: the race's velocity enters the normal
-    /// contact force only through the contact damper's term `c1 delta_dot` of eq. 7, so an error of
-    /// that size moves the force by at most `rtol` of itself, and the tolerance tightens
-    /// again as the force falls towards a lift-off. The race's velocity is a fast variable
-    /// there, whose error in an L-stable step spanning its modes would otherwise set the
-    /// step. Not applied with the `radial_only` support damper, which leaves the race's
-    /// tangential vibration undamped. Default true (the `standard` fidelity); false in
-    /// `draft` and `reference` (docs/accuracy.md#the-races-velocity-tolerance-in-contact).
+    /// velocity (never narrow it) to `rtol F_n / max(c1, c2)`: the race's velocity enters the
+    /// normal contact force only through the contact damper's term `c1 delta_dot` of eq. 7,
+    /// and the support force through `c2`, so an error of that size moves either damper's
+    /// force by at most `rtol F_n` in one step, and the tolerance tightens again as the force
+    /// falls towards a lift-off. The race's velocity is a fast variable there, whose error in
+    /// an L-stable step spanning its modes would otherwise set the step. Not applied with the
+    /// `radial_only` support damper (which leaves the race's tangential vibration undamped)
+    /// or without damping (`c1` or `c2` zero). Default true (the `standard` fidelity); false
+    /// in `draft` and `reference` (docs/accuracy.md#the-races-velocity-tolerance-in-contact).
     pub race_velocity_atol_from_force: bool,
 }
 

@@ -1,5 +1,5 @@
 //! `solver.race_velocity_atol_from_force`: while the contact carries load, the race's velocity
-//! tolerance is widened to `rtol F_n / c1`, the size of a velocity error that moves the
+//! tolerance is widened to `rtol F_n / max(c1, c2)`, the size of a velocity error that moves the
 //! contact damper's force (eq. 7) by `rtol` of the contact force.
 // `!(x < bound)` so a NaN fails.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -23,7 +23,7 @@ fn pressed(s: &Scene, delta_m: f64) -> (DropSystem, [f64; N]) {
 }
 
 /// Free flight keeps the tolerances; a loaded contact widens exactly the race's two velocity
-/// components to `rtol F_n / c1`; a lightly loaded one, where that is below the base, keeps
+/// components to `rtol F_n / max(c1, c2)`; a lightly loaded one, where that is below the base, keeps
 /// them (the tolerance is never narrowed); with the option off, the radial-only support
 /// damper or no support damping nothing changes.
 #[test]
