@@ -5,7 +5,9 @@
 //!
 //! - the **onset** of sustained whirl per friction coefficient as one curve (dots joined
 //!   between neighbouring coefficients that both whirl in the range); an onset found already
-//!   at the lowest scanned speed carries a downward arrow (at or below it);
+//!   at the lowest scanned speed carries a downward arrow (at or below it); an onset that
+//!   failed drops leave undecided (`undecided` in `critical.json`) is an open circle, joined
+//!   to no neighbour;
 //! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
 //!   to the top of the searched range;
 //! - **no whirl in range** as an open triangle at the range top;
@@ -199,12 +201,16 @@ impl Figure for Fig4<'_> {
             }
         }
 
-        // The onset curve: joined between neighbours that both whirl in the range.
+        // The onset curve: joined between neighbours that both whirl in the range and whose
+        // onsets are decided.
         let onsets: Vec<Option<(f64, f64)>> = rows
             .iter()
             .map(|r| r.onset_rpm.map(|o| (r.mu, clamp_value(o))))
             .collect();
-        for w in onsets.windows(2) {
+        for (w, r) in onsets.windows(2).zip(rows.windows(2)) {
+            if !joined(&r[0], &r[1]) {
+                continue;
+            }
             if let [Some(a), Some(b)] = w {
                 canvas.draw(&PathElement::new(
                     vec![px(a.0, a.1), px(b.0, b.1)],
@@ -213,11 +219,19 @@ impl Figure for Fig4<'_> {
             }
         }
         let mut any_below = false;
+        let mut any_undecided = false;
         for (r, o) in rows.iter().zip(&onsets) {
             let Some((mu, s)) = o else { continue };
             let p = px(*mu, *s);
-            canvas.draw(&Circle::new(p, 6, BAND.filled()))?;
-            canvas.draw(&Circle::new(p, 6, WHITE.stroke_width(1)))?;
+            if r.undecided {
+                // Failed drops could move this onset: an open circle.
+                any_undecided = true;
+                canvas.draw(&Circle::new(p, 6, WHITE.filled()))?;
+                canvas.draw(&Circle::new(p, 6, BAND.stroke_width(2)))?;
+            } else {
+                canvas.draw(&Circle::new(p, 6, BAND.filled()))?;
+                canvas.draw(&Circle::new(p, 6, WHITE.stroke_width(1)))?;
+            }
             if r.bracket_rpm.is_none() {
                 // Whirl already at the lowest scanned speed: the onset is at or below it.
                 any_below = true;
@@ -271,6 +285,12 @@ impl Figure for Fig4<'_> {
                 "onset at or below the lowest speed".to_string(),
             ));
         }
+        if any_undecided {
+            entries.push((
+                Mark::OpenDot(BAND),
+                "onset undecided: failed drops could move it".to_string(),
+            ));
+        }
         if any_none {
             entries.push((Mark::TriangleUp(NONE_MARK), "no whirl in range".to_string()));
         }
@@ -288,6 +308,12 @@ impl Figure for Fig4<'_> {
         }
         legend(&legend_band, &entries)
     }
+}
+
+/// Whether the onset curve joins two neighbouring rows: both whirl in the range and neither
+/// onset is undecided.
+fn joined(a: &CriticalRow, b: &CriticalRow) -> bool {
+    a.onset_rpm.is_some() && b.onset_rpm.is_some() && !a.undecided && !b.undecided
 }
 
 /// Converts an RGBA colour back to RGB (for swatches of mixed colours).
@@ -328,6 +354,51 @@ mod tests {
                 .collect(),
             non_monotone: false,
         }
+    }
+
+    /// An undecided onset is joined to no neighbour, and the chart draws it (as an open
+    /// circle, with its legend entry) where a decided onset would be a filled dot. The picture
+    /// is kept under the temp folder when `WHIRLMAP_KEEP_CHART` is set, to be looked at.
+    #[test]
+    fn an_undecided_onset_is_not_joined_and_is_drawn_apart() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/paper");
+        let mut rows = whirlmap_results::critical::read_critical(&dir)
+            .expect("committed critical.json")
+            .expect("a critical search");
+        rows.sort_by(|a, b| a.mu.total_cmp(&b.mu));
+        let i = rows
+            .iter()
+            .position(|r| (r.mu - 0.4).abs() < 1e-9)
+            .expect("mu 0.4");
+        assert!(joined(&rows[i - 1], &rows[i]) && joined(&rows[i], &rows[i + 1]));
+        rows[i].undecided = true;
+        rows[i].converged = false;
+        assert!(!joined(&rows[i - 1], &rows[i]) && !joined(&rows[i], &rows[i + 1]));
+        assert!(joined(&rows[i + 1], &rows[i + 2]), "the others stay joined");
+
+        let pixels = |rows: &[CriticalRow]| {
+            let path = std::env::temp_dir().join(format!(
+                "whirlmap-fig4-undecided-{}-{}.png",
+                std::process::id(),
+                rows.iter().filter(|r| r.undecided).count()
+            ));
+            let fig = Fig4 {
+                rows,
+                band: None,
+                title: "Fig. 4 with an undecided onset".into(),
+            };
+            crate::render::render(&path, (1000, 700), &fig).unwrap();
+            let bytes = std::fs::read(&path).unwrap();
+            if std::env::var_os("WHIRLMAP_KEEP_CHART").is_some() {
+                eprintln!("chart: {}", path.display());
+            } else {
+                std::fs::remove_file(&path).ok();
+            }
+            bytes
+        };
+        let mut decided = rows.clone();
+        decided[i].undecided = false;
+        assert_ne!(pixels(&rows), pixels(&decided));
     }
 
     #[test]
