@@ -208,7 +208,7 @@ impl Figure for Fig4<'_> {
             .map(|r| r.onset_rpm.map(|o| (r.mu, clamp_value(o))))
             .collect();
         for (w, r) in onsets.windows(2).zip(rows.windows(2)) {
-            if !joined(&r[0], &r[1]) {
+            if !joined(r[0], r[1]) {
                 continue;
             }
             if let [Some(a), Some(b)] = w {
