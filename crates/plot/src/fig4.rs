@@ -208,10 +208,7 @@ impl Figure for Fig4<'_> {
             .map(|r| r.onset_rpm.map(|o| (r.mu, clamp_value(o))))
             .collect();
         for (w, r) in onsets.windows(2).zip(rows.windows(2)) {
-            if !joined(r[0], r[1]) {
-                continue;
-            }
-            if let [Some(a), Some(b)] = w {
+            if let ([Some(a), Some(b)], true) = (w, joined(r[0], r[1])) {
                 canvas.draw(&PathElement::new(
                     vec![px(a.0, a.1), px(b.0, b.1)],
                     BAND.stroke_width(3),
