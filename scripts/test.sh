@@ -10,6 +10,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# A one-off build gains nothing from incremental state, which would add 0.7 GB to the
+# target folder (1.1 GB in all without it).
+export CARGO_INCREMENTAL=0
+
 echo "== cargo test --workspace"
 cargo test --workspace
 
