@@ -60,13 +60,31 @@ fn walk(given: &Value, shape: &Value, path: &str) -> Result<(), String> {
     }
 }
 
-/// Parses `text` as a `T` (serde's errors keep their line and column), then refuses a list
-/// wherever `T` has a struct ([`check_objects`]).
+/// Parses `text` as a `T`, then refuses a list wherever `T` has a struct
+/// ([`check_objects`]). A field's error names the field by its dotted path before serde's
+/// message, which keeps its line and column: `` `solver.rtol`: invalid type: string "x",
+/// expected f64 at line 1 column 23 ``.
 pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, serde_json::Error> {
-    let parsed: T = serde_json::from_str(text)?;
+    let mut de = serde_json::Deserializer::from_str(text);
+    let parsed: T = serde_path_to_error::deserialize(&mut de).map_err(with_path)?;
+    de.end()?;
     let given: Value = serde_json::from_str(text)?;
     check_objects(&given, &parsed).map_err(<serde_json::Error as serde::de::Error>::custom)?;
     Ok(parsed)
+}
+
+/// serde's error with the field's path in front of it; a syntax error, one at the top level
+/// or an unknown top-level key (serde names it) as it is.
+fn with_path(e: serde_path_to_error::Error<serde_json::Error>) -> serde_json::Error {
+    let path = e.path().to_string();
+    let inner = e.into_inner();
+    // serde names an unknown key itself; only a nested one needs its parents.
+    let says_itself = !path.contains('.') && inner.to_string().starts_with("unknown field");
+    if path == "." || says_itself || inner.is_syntax() || inner.is_eof() {
+        inner
+    } else {
+        <serde_json::Error as serde::de::Error>::custom(format!("`{path}`: {inner}"))
+    }
 }
 
 /// Reads a number that may have been written as `null`: serde_json writes a NaN (or an
@@ -97,6 +115,28 @@ mod tests {
         let s = from_str::<Scene>(r#"{"release_offset_m": [1e-5, 0], "speed_rpm": 1000}"#).unwrap();
         assert_eq!(s.release_offset_m, [1e-5, 0.0]);
         assert_eq!(s.speed_rpm, 1000.0);
+        // A wrong value names its field, nested ones by their dotted path, and keeps the
+        // place in the text.
+        let e = from_str::<Scene>(r#"{"clearance_m": "abc"}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("`clearance_m`: invalid type") && e.contains("column"),
+            "{e}"
+        );
+        let e = from_str::<Scene>(r#"{"solver": {"rtol": "x"}}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("`solver.rtol`: invalid type"), "{e}");
+        let e = from_str::<Scene>(r#"{"solver": {"rtoll": 1e-6}}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`solver.rtoll`") && e.contains("unknown field"),
+            "{e}"
+        );
+        // Text after the value is still refused.
+        assert!(from_str::<Scene>("{} x").is_err());
         // serde alone reads the list by position: the reason for the check.
         let by_position: Scene = serde_json::from_str("[1000, 0.1]").unwrap();
         assert_eq!(by_position.speed_rpm, 1000.0);
