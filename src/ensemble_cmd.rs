@@ -42,6 +42,11 @@ pub struct EnsembleCmdArgs {
     /// Refused: the full-grid comparison is `adaptive`'s.
     #[arg(long, hide = true)]
     compare_full: bool,
+    /// Continue an ensemble that did not finish in the output folder (killed, say): the
+    /// members already in its members.jsonl are kept and only the rest run. The folder's
+    /// manifest must name the same file contents, model version and whirlmap version.
+    #[arg(long, conflicts_with = "overwrite")]
+    resume: bool,
 }
 
 /// Arguments of `whirlmap adaptive`: those of `ensemble`, and `--compare-full` (which only
@@ -66,13 +71,27 @@ fn failure(e: SweepError) -> Failure {
 fn load(
     a: &EnsembleArgs,
     what: &str,
+    resume: bool,
 ) -> Result<(ensemble::EnsembleSpec, PathBuf, FolderLock), Failure> {
     let s = ensemble::load(&a.file).map_err(|e| Failure::coded(2, e))?;
     let out = a
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("results").join(&s.name));
-    crate::refuse_existing_results(&out, a.overwrite).map_err(Failure::Input)?;
+    // A folder without an ensemble's manifest has nothing to resume: it is refused as any
+    // folder with results is.
+    if !resume || !out.join(ensemble::MANIFEST_FILE).exists() {
+        crate::refuse_existing_results(&out, a.overwrite).map_err(|e| {
+            if what == "ensemble" {
+                Failure::Input(anyhow::anyhow!(
+                    "{e}; --resume continues an ensemble that did not finish there, keeping \
+                     its members"
+                ))
+            } else {
+                Failure::Input(e)
+            }
+        })?;
+    }
     let lock = std::fs::create_dir_all(&out)
         .map_err(|e| whirlmap_sweep::folder::output_error(&out, e))
         .and_then(|_| FolderLock::acquire(&out, what))
@@ -94,11 +113,22 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
         ));
     }
     let a = &args.common;
-    let (spec, out, _lock) = load(a, "ensemble")?;
-    let o = run_ensemble(&spec, &out, a.threads.map(|n| n as usize), !a.no_progress)
-        .map_err(failure)?;
+    let (spec, out, _lock) = load(a, "ensemble", args.resume)?;
+    let o = run_ensemble(
+        &spec,
+        &out,
+        a.threads.map(|n| n as usize),
+        !a.no_progress,
+        args.resume,
+    )
+    .map_err(failure)?;
+    let resumed = if o.resumed > 0 {
+        format!(" ({} resumed)", o.resumed)
+    } else {
+        String::new()
+    };
     outln!(
-        "ensemble {}: {} cells x {} members = {} drops, {} failed",
+        "ensemble {}: {} cells x {} members = {} drops{resumed}, {} failed",
         spec.name,
         o.cells,
         o.contours.members,
@@ -144,7 +174,7 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
 /// Runs `whirlmap adaptive`.
 pub fn run_adaptive_cmd(args: &AdaptiveArgs) -> CmdResult {
     let a = &args.common;
-    let (spec, out, _lock) = load(a, "adaptive")?;
+    let (spec, out, _lock) = load(a, "adaptive", false)?;
     let (r, path) = run_adaptive(
         &spec,
         &out,

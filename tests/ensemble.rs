@@ -218,3 +218,133 @@ fn compare_full_belongs_to_adaptive_only() {
     let help = out(&whirlmap(&["ensemble", "--help"]));
     assert!(!help.contains("--compare-full"), "{help}");
 }
+
+/// 40 one-second drops: long enough on one thread to be killed after a few records.
+const KILL_SPEC: &str = r#"{"name": "kill", "duration_s": 1.0,
+  "axes": {"speed_rpm": [4000, 8000], "mu": [0.3, 0.4]},
+  "ensemble": {"members": 10, "seed": 7,
+    "unbalance_m": {"uniform": {"from": 0, "to": 5e-6}},
+    "orbit_radius_m": {"normal": {"mean": 5e-6, "sd": 3e-6, "min": 0, "max": 2e-5}}}}"#;
+
+/// Runs `whirlmap ensemble spec --out out` on one thread and kills it once `members.jsonl`
+/// holds two records (and before it holds all 40).
+fn kill_after_two_members(spec: &Path, out: &Path) {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let mut child = Command::new(BIN)
+        .args([
+            "ensemble",
+            s(spec),
+            "--out",
+            s(out),
+            "--threads",
+            "1",
+            "--no-progress",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let members = out.join("members.jsonl");
+    let start = Instant::now();
+    loop {
+        let n = std::fs::read_to_string(&members)
+            .map(|t| t.matches('\n').count())
+            .unwrap_or(0);
+        if n >= 2 {
+            assert!(n < 40, "the ensemble finished before it could be killed");
+            child.kill().unwrap();
+            break;
+        }
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "ended before 2 members"
+        );
+        assert!(start.elapsed() < Duration::from_secs(120), "no progress");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.wait().unwrap();
+}
+
+#[test]
+fn a_killed_ensemble_keeps_its_members_and_resumes_to_the_uninterrupted_files() {
+    let dir = temp_dir("ens-kill");
+    let spec = spec_file(&dir, "kill.json", KILL_SPEC);
+    let (full, killed) = (dir.join("full"), dir.join("killed"));
+    kill_after_two_members(&spec, &killed);
+    // What the kill left: the members written so far and a manifest saying so.
+    let m = read_json(&killed.join("manifest.json"));
+    assert_eq!(m["complete"], false, "{m}");
+    assert!(!killed.join("cells.jsonl").exists());
+    let before = read(&killed.join("members.jsonl"));
+    let kept = before.matches('\n').count();
+    // A crash in the middle of a write leaves a torn line.
+    let mut torn = before[..before.rfind('\n').unwrap() + 1].to_string();
+    torn.push_str(r#"{"cell":0,"member":"#);
+    std::fs::write(killed.join("members.jsonl"), &torn).unwrap();
+
+    // Without --resume the folder is refused, and the message says how to go on.
+    let o = whirlmap(&["ensemble", s(&spec), "--out", s(&killed), "--no-progress"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--resume"), "{}", stderr(&o));
+    // --resume and --overwrite exclude each other.
+    let o = whirlmap(&[
+        "ensemble",
+        s(&spec),
+        "--out",
+        s(&killed),
+        "--resume",
+        "--overwrite",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    // Another spec's members are not continued: the refusal names what differs.
+    let other = spec_file(
+        &dir,
+        "other.json",
+        &KILL_SPEC.replace("\"seed\": 7", "\"seed\": 8"),
+    );
+    let o = whirlmap(&["ensemble", s(&other), "--out", s(&killed), "--resume"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("seed"), "{}", stderr(&o));
+    assert_eq!(
+        read(&killed.join("members.jsonl")),
+        torn,
+        "a refusal changes nothing"
+    );
+
+    let o = whirlmap(&[
+        "ensemble",
+        s(&spec),
+        "--out",
+        s(&killed),
+        "--threads",
+        "2",
+        "--resume",
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        out(&o).contains(&format!("= 40 drops ({kept} resumed)")),
+        "{}",
+        out(&o)
+    );
+    let o = whirlmap(&[
+        "ensemble",
+        s(&spec),
+        "--out",
+        s(&full),
+        "--threads",
+        "2",
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for f in OUTPUTS {
+        assert_eq!(read(&full.join(f)), read(&killed.join(f)), "{f}");
+    }
+    let m = read_json(&killed.join("manifest.json"));
+    assert_eq!(
+        (m["complete"].clone(), m["drops"].clone()),
+        (true.into(), 40.into())
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

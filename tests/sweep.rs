@@ -428,3 +428,73 @@ fn a_killed_run_on_three_threads_holds_a_grid_prefix_and_resumes_to_the_same_byt
     assert_eq!(m["counts"]["ok"], 24);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A sweep killed while its probability ensemble ran keeps that ensemble's members on
+/// `--resume`: the kill is staged (the members cut to three, the ensemble's files after
+/// them removed, its manifest marked unfinished), and one kept record is marked so that a
+/// rerun of that member would show.
+#[test]
+fn a_resumed_sweep_keeps_the_members_its_probability_ensemble_wrote() {
+    let dir = temp_dir("resume-probability");
+    let spec = spec_file(
+        &dir,
+        "p.json",
+        r#"{"name": "p", "duration_s": 0.05,
+            "axes": {"speed_rpm": [4000], "mu": [0.3]},
+            "probability": {"axes": {"speed_rpm": [4000, 8000], "mu": [0.3]},
+              "duration_s": 0.05,
+              "ensemble": {"members": 3, "seed": 1,
+                "unbalance_m": {"uniform": {"from": 0, "to": 5e-6}}}}}"#,
+    );
+    let (full, killed) = (dir.join("full"), dir.join("killed"));
+    for out in [&full, &killed] {
+        let o = whirlmap(&["sweep", s(&spec), "--out", s(out), "--no-progress"]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    }
+    let p = killed.join("probability");
+    let members = std::fs::read_to_string(p.join("members.jsonl")).unwrap();
+    assert_eq!(members.lines().count(), 6);
+    // Edited as text: the record's keys keep their order.
+    let first = members.lines().next().unwrap();
+    let at = first.find("\"peak_heat_power_w\":").unwrap() + "\"peak_heat_power_w\":".len();
+    let end = at + first[at..].find([',', '}']).unwrap();
+    let mut cut = format!("{}12345.0{}\n", &first[..at], &first[end..]);
+    for l in members.lines().skip(1).take(2) {
+        cut.push_str(l);
+        cut.push('\n');
+    }
+    std::fs::write(p.join("members.jsonl"), &cut).unwrap();
+    for f in ["cells.jsonl", "cells.csv", "contours.json"] {
+        std::fs::remove_file(p.join(f)).unwrap();
+    }
+    let m = std::fs::read_to_string(p.join("manifest.json")).unwrap();
+    std::fs::write(
+        p.join("manifest.json"),
+        m.replace("\"complete\": true", "\"complete\": false"),
+    )
+    .unwrap();
+
+    let o = whirlmap(&[
+        "sweep",
+        s(&spec),
+        "--out",
+        s(&killed),
+        "--resume",
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let after: Vec<serde_json::Value> = lines(&p.join("members.jsonl"));
+    assert_eq!(after.len(), 6);
+    assert_eq!(
+        after[0]["peak_heat_power_w"], 12345.0,
+        "the first member was kept"
+    );
+    let fresh = lines(&full.join("probability/members.jsonl"));
+    assert_eq!(
+        after[1..],
+        fresh[1..],
+        "the rest as an uninterrupted run has them"
+    );
+    assert_eq!(read_json(&p.join("manifest.json"))["complete"], true);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -241,9 +241,14 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for SortedKeys<T> {
 pub struct EnsembleManifest<S> {
     /// Cells of the grid.
     pub cells: usize,
-    /// Drops run (cells x members).
+    /// `false` while the ensemble runs (written before its first drop, so a `--resume` knows
+    /// which spec the members already in `members.jsonl` belong to), `true` once every file
+    /// is written. Manifests without the key were only ever written complete.
+    #[serde(default = "complete_by_default")]
+    pub complete: bool,
+    /// Drops (cells x members; while running: the drops planned).
     pub drops: usize,
-    /// Drops that failed.
+    /// Drops that failed (while running: 0).
     pub failed: usize,
     /// The model version of the binary that ran them.
     pub model_version: u32,
@@ -255,6 +260,11 @@ pub struct EnsembleManifest<S> {
     pub wall_time_s: f64,
     /// The whirlmap version of the binary.
     pub whirlmap_version: String,
+}
+
+/// An ensemble manifest without `complete` was written by an older whirlmap at the end.
+fn complete_by_default() -> bool {
+    true
 }
 
 impl<S: Serialize> EnsembleManifest<S> {
@@ -305,6 +315,7 @@ mod tests {
         assert_eq!(back, row);
         let m = EnsembleManifest {
             cells: 1,
+            complete: true,
             drops: 2,
             failed: 0,
             model_version: 5,
@@ -315,8 +326,13 @@ mod tests {
         };
         let text = m.to_text();
         assert!(text.contains("\"spec\": {\n    \"axes\": {},\n    \"name\": \"e\"\n  }"));
+        assert!(text.starts_with("{\n  \"cells\": 1,\n  \"complete\": true,\n  \"drops\""));
         let view: ManifestView = serde_json::from_str(&text).unwrap();
         assert_eq!(view.files, None);
-        assert_eq!(view.complete, None);
+        assert_eq!(view.complete, Some(true));
+        // A manifest from before the key was only ever written complete.
+        let old = text.replace("  \"complete\": true,\n", "");
+        let back: EnsembleManifest<serde_json::Value> = serde_json::from_str(&old).unwrap();
+        assert!(back.complete);
     }
 }

@@ -725,6 +725,9 @@ pub struct EnsembleOutcome {
     pub drops: usize,
     /// Drops that failed.
     pub failed: usize,
+    /// Drops a `--resume` took from the folder's `members.jsonl` instead of running them
+    /// (counted in `drops`).
+    pub resumed: usize,
     /// The per-cell statistics.
     pub stats: Vec<CellStats>,
     /// The contours.
@@ -795,14 +798,273 @@ fn cells_csv(stats: &[CellStats]) -> String {
 /// workers (`None`: rayon's default) and writes `members.jsonl`, `cells.jsonl`, `cells.csv`,
 /// `contours.json` and `manifest.json` to `out_dir`. Every file but the manifest is
 /// byte-identical for any thread count.
+///
+/// The manifest is written first (`complete` false), and each member's record is appended
+/// to `members.jsonl` in (cell, member) order as soon as it and every member before it are
+/// done ([`MemberWriter`]), so a killed run keeps every record it wrote. With `resume`, the
+/// members the folder already holds are kept and only the rest run: the folder's manifest
+/// must name the same spec, model version and whirlmap version ([`resumable_members`]); a
+/// folder with no members starts anew. The result is the same, byte for byte, as one run
+/// from the start.
 pub fn run_ensemble(
     spec: &EnsembleSpec,
     out_dir: &Path,
     threads: Option<usize>,
     show_progress: bool,
+    resume: bool,
 ) -> Result<EnsembleOutcome, SweepError> {
     let pool = crate::pool::pool(threads).map_err(|e| SweepError::ThreadPool(e.to_string()))?;
-    pool.install(|| run_ensemble_here(spec, out_dir, show_progress))
+    pool.install(|| run_ensemble_here(spec, out_dir, show_progress, resume))
+}
+
+/// At most this long between syncs of `members.jsonl` while members are being written (a
+/// power loss loses at most the last second's records; a kill loses none that were written).
+const SYNC_EVERY: Duration = Duration::from_secs(1);
+
+/// The reorder window per worker thread, as the sweep's grid has it: a worker takes member
+/// `k` only while `k < written + WINDOW_PER_THREAD x threads`, so the records done but held
+/// back by a slower member before them (lost if the run is killed) stay few.
+const WINDOW_PER_THREAD: usize = 16;
+
+/// Appends member records to `members.jsonl` in order as they complete: the worker that
+/// completes the first missing member writes it and every done member after it, with one
+/// `write_all` and a flush (so a kill loses none), syncing at most [`SYNC_EVERY`] apart.
+/// Runs on the threads of the current rayon pool (also from one of its threads, as a
+/// sweep's extras call it), each worker taking the next member from a shared counter.
+struct MemberWriter {
+    path: PathBuf,
+    state: Mutex<WriterState>,
+    moved: std::sync::Condvar,
+}
+
+struct WriterState {
+    file: std::fs::File,
+    /// The next member not yet taken by a worker.
+    next: usize,
+    /// Members written (all of `0..written`, in `records`).
+    written: usize,
+    /// Done members waiting for one before them.
+    waiting: BTreeMap<usize, MemberRecord>,
+    /// Every record written, resumed ones first.
+    records: Vec<MemberRecord>,
+    last_sync: Instant,
+    error: Option<SweepError>,
+}
+
+impl MemberWriter {
+    /// Runs members `from..total` (`run(k)` for member `k`) with `workers` threads, appending
+    /// to `file`, whose first `from` records are `kept`. Returns every record in order.
+    fn run(
+        path: PathBuf,
+        file: std::fs::File,
+        kept: Vec<MemberRecord>,
+        total: usize,
+        workers: usize,
+        run: &(dyn Fn(usize) -> MemberRecord + Sync),
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Vec<MemberRecord>, SweepError> {
+        let from = kept.len();
+        let window = WINDOW_PER_THREAD * workers.max(1);
+        let w = MemberWriter {
+            path,
+            state: Mutex::new(WriterState {
+                file,
+                next: from,
+                written: from,
+                waiting: BTreeMap::new(),
+                records: kept,
+                last_sync: Instant::now(),
+                error: None,
+            }),
+            moved: std::sync::Condvar::new(),
+        };
+        (0..workers.max(1))
+            .into_par_iter()
+            .for_each(|_| w.work(total, window, run, progress));
+        let mut st = w.state.into_inner().unwrap_or_else(|e| e.into_inner());
+        if let Some(e) = st.error.take() {
+            return Err(e);
+        }
+        st.file
+            .sync_data()
+            .map_err(|e| crate::folder::output_error(&w.path, e))?;
+        Ok(st.records)
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, WriterState> {
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// One worker: take the next member (within the window), run it, hand it in.
+    fn work(
+        &self,
+        total: usize,
+        window: usize,
+        run: &(dyn Fn(usize) -> MemberRecord + Sync),
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) {
+        loop {
+            let k = {
+                let mut st = self.lock();
+                while st.error.is_none() && st.next < total && st.next >= st.written + window {
+                    st = self.moved.wait(st).unwrap_or_else(|e| e.into_inner());
+                }
+                if st.error.is_some() || st.next >= total {
+                    return;
+                }
+                st.next += 1;
+                st.next - 1
+            };
+            let record = run(k);
+            let done = {
+                let mut st = self.lock();
+                st.waiting.insert(k, record);
+                if let Err(e) = self.write_ready(&mut st) {
+                    st.error.get_or_insert(e);
+                }
+                st.written
+            };
+            self.moved.notify_all();
+            progress(done, total);
+        }
+    }
+
+    /// Writes every waiting record that follows the written ones without a gap.
+    fn write_ready(&self, st: &mut WriterState) -> Result<(), SweepError> {
+        use std::io::Write;
+        let mut text = String::new();
+        let mut next = st.written;
+        while let Some(r) = st.waiting.remove(&next) {
+            text.push_str(&serde_json::to_string(&r).expect("records serialise"));
+            text.push('\n');
+            st.records.push(r);
+            next += 1;
+        }
+        if text.is_empty() {
+            return Ok(());
+        }
+        let err = |e| crate::folder::output_error(&self.path, e);
+        st.file.write_all(text.as_bytes()).map_err(err)?;
+        st.file.flush().map_err(err)?;
+        st.written = next;
+        if st.last_sync.elapsed() >= SYNC_EVERY {
+            st.file.sync_data().map_err(err)?;
+            st.last_sync = Instant::now();
+        }
+        Ok(())
+    }
+}
+
+/// The manifest of a run of `spec` over `cells`.
+fn manifest<'a>(
+    spec: &'a EnsembleSpec,
+    cells: usize,
+    members: &[MemberRecord],
+    complete: bool,
+    planned: usize,
+    wall_time_s: f64,
+) -> EnsembleManifest<&'a EnsembleSpec> {
+    EnsembleManifest {
+        cells,
+        complete,
+        drops: if complete { members.len() } else { planned },
+        failed: members.iter().filter(|m| m.class.is_none()).count(),
+        model_version: whirlmap_core::MODEL_VERSION,
+        spec: SortedKeys(spec),
+        threads: rayon::current_num_threads(),
+        wall_time_s,
+        whirlmap_version: env!("CARGO_PKG_VERSION").to_string(),
+    }
+}
+
+/// The members a `--resume` keeps from `out_dir`, and the length in bytes of
+/// `members.jsonl` they fill: every whole line from the start that reads as the record of the
+/// member at its position (cell `k / members`, member `k % members`, with the inputs and drawn
+/// values this spec gives it), up to the first that does not (a line cut short by a kill, say).
+/// Refused (exit 2) when the folder's manifest is not an ensemble's, is unreadable, or names
+/// another spec, model version or whirlmap version, or is missing while members are there.
+/// A folder with neither has nothing to keep.
+pub fn resumable_members(
+    spec: &EnsembleSpec,
+    params: &EnsembleParams,
+    cells: &[Cell],
+    out_dir: &Path,
+) -> Result<(Vec<MemberRecord>, u64), SweepError> {
+    let members_path = out_dir.join(MEMBERS_FILE);
+    let bytes = match std::fs::read(&members_path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(e) => return Err(crate::folder::output_error(&members_path, e)),
+    };
+    let refuse = |why: String| {
+        SweepError::Refused(format!(
+            "cannot resume the ensemble in {}: {why}. Use --overwrite to replace it, or choose \
+             another --out",
+            out_dir.display()
+        ))
+    };
+    let text = match std::fs::read_to_string(out_dir.join(MANIFEST_FILE)) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound && bytes.is_empty() => {
+            return Ok((Vec::new(), 0))
+        }
+        Err(e) => {
+            return Err(refuse(format!(
+                "it holds members but no readable manifest.json saying which spec they belong \
+                 to ({e})"
+            )))
+        }
+    };
+    // Also refuses another command's manifest (a sweep's), which the ensemble's would replace.
+    let m: EnsembleManifest<serde_json::Value> = serde_json::from_str(&text).map_err(|e| {
+        refuse(format!(
+            "its manifest.json is not an ensemble's or is unreadable ({e})"
+        ))
+    })?;
+    let this = serde_json::to_value(spec).expect("specs serialise");
+    if m.spec.0 != this {
+        let diffs = crate::folder::value_differences(&m.spec.0, &this);
+        return Err(refuse(format!(
+            "its members belong to another spec ({})",
+            diffs.join("; ")
+        )));
+    }
+    if m.model_version != whirlmap_core::MODEL_VERSION {
+        return Err(refuse(format!(
+            "its members were computed with model version {}, this whirlmap has {}",
+            m.model_version,
+            whirlmap_core::MODEL_VERSION
+        )));
+    }
+    if m.whirlmap_version != env!("CARGO_PKG_VERSION") {
+        return Err(refuse(format!(
+            "its members were computed by whirlmap {}, this is {}",
+            m.whirlmap_version,
+            env!("CARGO_PKG_VERSION")
+        )));
+    }
+    let total = cells.len() * params.members;
+    let mut kept = Vec::new();
+    let mut len = 0usize;
+    for line in bytes.split_inclusive(|b| *b == b'\n') {
+        let k = kept.len();
+        if k >= total || line.last() != Some(&b'\n') {
+            break;
+        }
+        let Ok(r) = serde_json::from_slice::<MemberRecord>(line) else {
+            break;
+        };
+        let cell = &cells[k / params.members];
+        let member = k % params.members;
+        let (_, drawn) = params.member_scene(&cell.scene, &cell.inputs, member);
+        if r.cell != cell.index || r.member != member || r.inputs != cell.inputs || r.drawn != drawn
+        {
+            break;
+        }
+        kept.push(r);
+        len += line.len();
+    }
+    Ok((kept, len as u64))
 }
 
 /// [`run_ensemble`] on the current rayon pool (so it can share a pool with other work, as a
@@ -811,6 +1073,7 @@ pub fn run_ensemble_here(
     spec: &EnsembleSpec,
     out_dir: &Path,
     show_progress: bool,
+    resume: bool,
 ) -> Result<EnsembleOutcome, SweepError> {
     let cells = spec.cells()?;
     let params = spec
@@ -819,6 +1082,42 @@ pub fn run_ensemble_here(
         .ok_or_else(|| invalid("ensemble", "(missing)", "an ensemble section"))?;
     check_output_dir(out_dir)?;
     let start = Instant::now();
+    let total = cells.len() * params.members;
+    let (kept, kept_len) = if resume {
+        resumable_members(spec, params, &cells, out_dir)?
+    } else {
+        (Vec::new(), 0)
+    };
+    let resumed = kept.len();
+    // What an earlier run derived from its members is written anew at the end.
+    let mut written = Vec::new();
+    for name in [CELLS_FILE, CELLS_CSV, CONTOURS_FILE] {
+        let p = out_dir.join(name);
+        match std::fs::remove_file(&p) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(crate::folder::output_error(&p, e))
+            }
+            _ => {}
+        }
+    }
+    let m = manifest(spec, cells.len(), &[], false, total, 0.0);
+    crate::folder::write_atomic(&out_dir.join(MANIFEST_FILE), m.to_text().as_bytes())?;
+    let members_path = out_dir.join(MEMBERS_FILE);
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .write(true)
+        .truncate(false)
+        .open(&members_path)
+        .and_then(|f| {
+            f.set_len(kept_len)?;
+            Ok(f)
+        })
+        .and_then(|mut f| {
+            use std::io::Seek;
+            f.seek(std::io::SeekFrom::End(0))?;
+            Ok(f)
+        })
+        .map_err(|e| crate::folder::output_error(&members_path, e))?;
     let last = Mutex::new(Instant::now());
     let progress = |done: usize, total: usize| {
         if !show_progress {
@@ -827,14 +1126,36 @@ pub fn run_ensemble_here(
         let mut last = last.lock().unwrap_or_else(|e| e.into_inner());
         if last.elapsed() >= Duration::from_secs(5) || done == total {
             *last = Instant::now();
+            let resumed = if resumed > 0 {
+                format!(" ({resumed} resumed)")
+            } else {
+                String::new()
+            };
             crate::sweep::progress_line(&format!(
-                "ensemble {}: {done}/{total} drops, {:.0} s",
+                "ensemble {}: {done}/{total} drops{resumed}, {:.0} s",
                 spec.name,
                 start.elapsed().as_secs_f64()
             ));
         }
     };
-    let members = run_members(params, &cells, spec.duration_s, &progress);
+    let run = |k: usize| {
+        run_member(
+            params,
+            &cells[k / params.members],
+            k % params.members,
+            spec.duration_s,
+        )
+    };
+    let members = MemberWriter::run(
+        members_path.clone(),
+        file,
+        kept,
+        total,
+        rayon::current_num_threads(),
+        &run,
+        &progress,
+    )?;
+    written.push(members_path);
     let z = z_for_confidence(params.confidence);
     let stats: Vec<CellStats> = cells
         .iter()
@@ -847,14 +1168,6 @@ pub fn run_ensemble_here(
         confidence: params.confidence,
         groups: contours(&stats, &params.levels),
     };
-
-    let mut written = Vec::new();
-    let mut text = String::new();
-    for m in &members {
-        text.push_str(&serde_json::to_string(m).expect("records serialise"));
-        text.push('\n');
-    }
-    write_file(&out_dir.join(MEMBERS_FILE), &text, &mut written)?;
     let mut text = String::new();
     for c in &stats {
         text.push_str(&serde_json::to_string(c).expect("records serialise"));
@@ -868,26 +1181,21 @@ pub fn run_ensemble_here(
         &format!("{text}\n"),
         &mut written,
     )?;
-    let failed = members.iter().filter(|m| m.class.is_none()).count();
-    let manifest = EnsembleManifest {
-        cells: cells.len(),
-        drops: members.len(),
-        failed,
-        model_version: whirlmap_core::MODEL_VERSION,
-        spec: SortedKeys(spec),
-        threads: rayon::current_num_threads(),
-        wall_time_s: start.elapsed().as_secs_f64(),
-        whirlmap_version: env!("CARGO_PKG_VERSION").to_string(),
-    };
-    write_file(
-        &out_dir.join(MANIFEST_FILE),
-        &manifest.to_text(),
-        &mut written,
-    )?;
+    let m = manifest(
+        spec,
+        cells.len(),
+        &members,
+        true,
+        total,
+        start.elapsed().as_secs_f64(),
+    );
+    let failed = m.failed;
+    write_file(&out_dir.join(MANIFEST_FILE), &m.to_text(), &mut written)?;
     Ok(EnsembleOutcome {
         cells: cells.len(),
         drops: members.len(),
         failed,
+        resumed,
         stats,
         contours: contours_file,
         written,

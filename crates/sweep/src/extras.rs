@@ -76,18 +76,21 @@ pub fn run_all(
     threads: Option<usize>,
     progress: bool,
 ) -> Result<ExtrasWritten, ExtrasError> {
-    run_all_owned(spec, out_dir, threads, progress, |_| true)
+    run_all_owned(spec, out_dir, threads, progress, false, |_| true)
 }
 
 /// [`run_all`] for a shard's part: the critical searches at positions `j` of `critical.mu`
 /// and the orbit panels at positions `i` for which `owns` is true, and the probability
 /// ensemble when `owns(0)` (it is one job). When more than one fails, the error reported is
-/// the critical search's, then the orbits', then the ensemble's.
+/// the critical search's, then the orbits', then the ensemble's. With `resume` (a sweep's
+/// `--resume`), the ensemble keeps the members its folder already holds
+/// ([`crate::ensemble::run_ensemble`]); the critical search and the orbits run anew.
 pub fn run_all_owned(
     spec: &SweepSpec,
     out_dir: &Path,
     threads: Option<usize>,
     progress: bool,
+    resume: bool,
     owns: impl Fn(usize) -> bool + Sync,
 ) -> Result<ExtrasWritten, ExtrasError> {
     let panels = orbit_panels(spec).map_or(0, |(_, mus)| mus.len());
@@ -108,7 +111,7 @@ pub fn run_all_owned(
             },
             || {
                 if owns(0) {
-                    run_probability_here(spec, out_dir, progress)
+                    run_probability_here(spec, out_dir, progress, resume)
                 } else {
                     Ok(None)
                 }
@@ -138,7 +141,8 @@ pub fn run_probability(
         return Ok(None);
     };
     let dir = out_dir.join(PROBABILITY_DIR);
-    crate::ensemble::run_ensemble(&e, &dir, threads, progress).map_err(ExtrasError::from_sweep)?;
+    crate::ensemble::run_ensemble(&e, &dir, threads, progress, false)
+        .map_err(ExtrasError::from_sweep)?;
     Ok(Some(dir))
 }
 
@@ -147,12 +151,14 @@ fn run_probability_here(
     spec: &SweepSpec,
     out_dir: &Path,
     progress: bool,
+    resume: bool,
 ) -> Result<Option<PathBuf>, ExtrasError> {
     let Some(e) = spec.probability_spec() else {
         return Ok(None);
     };
     let dir = out_dir.join(PROBABILITY_DIR);
-    crate::ensemble::run_ensemble_here(&e, &dir, progress).map_err(ExtrasError::from_sweep)?;
+    crate::ensemble::run_ensemble_here(&e, &dir, progress, resume)
+        .map_err(ExtrasError::from_sweep)?;
     Ok(Some(dir))
 }
 

@@ -11,7 +11,8 @@
 //! ## What a run owns
 //! Every name in [`OWNED`] is whirlmap's. A new run into a folder that holds any of them is
 //! refused (exit 2) unless it is told `--resume` (the same spec and build: the records are
-//! kept, every derived file is removed and made again) or `--overwrite` (the old files are
+//! kept, and so are the probability ensemble's members in `probability/`; every other
+//! derived file is removed and made again) or `--overwrite` (the old files are
 //! moved into [`PREVIOUS_DIR`] and deleted once the new run's first records are synced to
 //! disk, so a rerun killed early loses nothing). Other files are left alone and never read.
 //!
@@ -70,7 +71,6 @@ const DERIVED: &[&str] = &[
     CRITICAL_CSV_FILE,
     ORBITS_DIR,
     CHARTS_DIR,
-    PROBABILITY_DIR,
     COMPARE_REPORT_FILE,
     COMPARE_CLASSES_FILE,
 ];

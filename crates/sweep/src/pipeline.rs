@@ -104,8 +104,22 @@ pub fn run(
     (stages.on_grid)(&run.outcome);
     let progress = opts.progress != ProgressMode::Off;
     let extras = match shard {
-        Some(s) => run_all_owned(spec, &opts.out_dir, opts.threads, progress, |k| s.owns(k))?,
-        None => run_all_owned(spec, &opts.out_dir, opts.threads, progress, |_| true)?,
+        Some(s) => run_all_owned(
+            spec,
+            &opts.out_dir,
+            opts.threads,
+            progress,
+            opts.resume,
+            |k| s.owns(k),
+        )?,
+        None => run_all_owned(
+            spec,
+            &opts.out_dir,
+            opts.threads,
+            progress,
+            opts.resume,
+            |_| true,
+        )?,
     };
     record_extras(&mut run, &opts.out_dir, &extras)?;
     let charts = match shard_manifest {
