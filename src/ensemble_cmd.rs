@@ -82,7 +82,7 @@ fn load(
     // folder with results is.
     if !resume || !out.join(ensemble::MANIFEST_FILE).exists() {
         crate::refuse_existing_results(&out, a.overwrite).map_err(|e| {
-            if what == "ensemble" {
+            if what == "ensemble" && !resume {
                 Failure::Input(anyhow::anyhow!(
                     "{e}; --resume continues an ensemble that did not finish there, keeping \
                      its members"

@@ -226,7 +226,7 @@ const KILL_SPEC: &str = r#"{"name": "kill", "duration_s": 1.0,
     "unbalance_m": {"uniform": {"from": 0, "to": 5e-6}},
     "orbit_radius_m": {"normal": {"mean": 5e-6, "sd": 3e-6, "min": 0, "max": 2e-5}}}}"#;
 
-/// Runs `whirlmap ensemble spec --out out` on one thread and kills it once `members.jsonl`
+/// Runs `whirlmap ensemble spec --out out` on two threads and kills it once `members.jsonl`
 /// holds two records (and before it holds all 40).
 fn kill_after_two_members(spec: &Path, out: &Path) {
     use std::process::{Command, Stdio};
@@ -238,7 +238,7 @@ fn kill_after_two_members(spec: &Path, out: &Path) {
             "--out",
             s(out),
             "--threads",
-            "1",
+            "2",
             "--no-progress",
         ])
         .stdout(Stdio::null())
@@ -311,6 +311,40 @@ fn a_killed_ensemble_keeps_its_members_and_resumes_to_the_uninterrupted_files() 
         torn,
         "a refusal changes nothing"
     );
+    // Nor are members of another model version or build, nor lines out of place.
+    let manifest = read(&killed.join("manifest.json"));
+    let version = read_json(&killed.join("manifest.json"))["model_version"].clone();
+    let edits = [
+        (
+            format!("\"model_version\": {version}"),
+            "\"model_version\": 1".to_string(),
+            "model version 1",
+        ),
+        (
+            "\"git_commit\": \"".to_string(),
+            "\"git_commit\": \"0000".to_string(),
+            "two builds",
+        ),
+    ];
+    for (from, to, says) in edits {
+        assert!(manifest.contains(&from), "{from}");
+        std::fs::write(killed.join("manifest.json"), manifest.replace(&from, &to)).unwrap();
+        let o = whirlmap(&["ensemble", s(&spec), "--out", s(&killed), "--resume"]);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(stderr(&o).contains(says), "{says}: {}", stderr(&o));
+    }
+    std::fs::write(killed.join("manifest.json"), &manifest).unwrap();
+    let mut swapped: Vec<&str> = torn.lines().collect();
+    swapped.swap(0, 1);
+    std::fs::write(killed.join("members.jsonl"), swapped.join("\n") + "\n").unwrap();
+    let o = whirlmap(&["ensemble", s(&spec), "--out", s(&killed), "--resume"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("line 1 of members.jsonl"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::write(killed.join("members.jsonl"), &torn).unwrap();
 
     let o = whirlmap(&[
         "ensemble",

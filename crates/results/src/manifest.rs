@@ -250,6 +250,9 @@ pub struct EnsembleManifest<S> {
     pub drops: usize,
     /// Drops that failed (while running: 0).
     pub failed: usize,
+    /// The commit the binary was built from (absent in an older whirlmap's manifest).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub git_commit: Option<String>,
     /// The model version of the binary that ran them.
     pub model_version: u32,
     /// The ensemble spec.
@@ -318,6 +321,7 @@ mod tests {
             complete: true,
             drops: 2,
             failed: 0,
+            git_commit: Some("abc".into()),
             model_version: 5,
             spec: SortedKeys(serde_json::json!({"name": "e", "axes": {}})),
             threads: 2,
@@ -327,12 +331,16 @@ mod tests {
         let text = m.to_text();
         assert!(text.contains("\"spec\": {\n    \"axes\": {},\n    \"name\": \"e\"\n  }"));
         assert!(text.starts_with("{\n  \"cells\": 1,\n  \"complete\": true,\n  \"drops\""));
+        assert!(text.contains("\"failed\": 0,\n  \"git_commit\": \"abc\",\n  \"model_version\""));
         let view: ManifestView = serde_json::from_str(&text).unwrap();
         assert_eq!(view.files, None);
         assert_eq!(view.complete, Some(true));
         // A manifest from before the key was only ever written complete.
-        let old = text.replace("  \"complete\": true,\n", "");
+        let old = text
+            .replace("  \"complete\": true,\n", "")
+            .replace("  \"git_commit\": \"abc\",\n", "");
         let back: EnsembleManifest<serde_json::Value> = serde_json::from_str(&old).unwrap();
         assert!(back.complete);
+        assert_eq!(back.git_commit, None);
     }
 }

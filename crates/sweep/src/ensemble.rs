@@ -828,13 +828,21 @@ const WINDOW_PER_THREAD: usize = 16;
 
 /// Appends member records to `members.jsonl` in order as they complete: the worker that
 /// completes the first missing member writes it and every done member after it, with one
-/// `write_all` and a flush (so a kill loses none), syncing at most [`SYNC_EVERY`] apart.
-/// Runs on the threads of the current rayon pool (also from one of its threads, as a
-/// sweep's extras call it), each worker taking the next member from a shared counter.
+/// `write_all` (no user-space buffer, so a kill loses none), and a syncing thread outside
+/// the pool syncs the file at most [`SYNC_EVERY`] after a write. Runs on the threads of the
+/// current rayon pool (also from one of its threads, as a sweep's extras call it), each
+/// worker taking the next member from a shared counter.
+///
+/// A worker waits (blocking its pool thread) only while the first unwritten member runs on
+/// another worker: that member's drop never calls back into rayon, so it always ends and
+/// wakes the waiting ones. A panic in a member stops the others taking members (the
+/// [`StopOnPanic`] guard) and is re-raised once they return.
 struct MemberWriter {
     path: PathBuf,
     state: Mutex<WriterState>,
     moved: std::sync::Condvar,
+    /// Written since the last sync.
+    dirty: std::sync::atomic::AtomicBool,
 }
 
 struct WriterState {
@@ -847,8 +855,21 @@ struct WriterState {
     waiting: BTreeMap<usize, MemberRecord>,
     /// Every record written, resumed ones first.
     records: Vec<MemberRecord>,
-    last_sync: Instant,
+    /// Take no more members: an error (kept here) or a panic.
+    stop: bool,
     error: Option<SweepError>,
+}
+
+/// Stops the other workers when the one holding it panics.
+struct StopOnPanic<'a>(&'a MemberWriter);
+
+impl Drop for StopOnPanic<'_> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.0.lock().stop = true;
+            self.0.moved.notify_all();
+        }
+    }
 }
 
 impl MemberWriter {
@@ -865,6 +886,9 @@ impl MemberWriter {
     ) -> Result<Vec<MemberRecord>, SweepError> {
         let from = kept.len();
         let window = WINDOW_PER_THREAD * workers.max(1);
+        let syncing = file
+            .try_clone()
+            .map_err(|e| crate::folder::output_error(&path, e))?;
         let w = MemberWriter {
             path,
             state: Mutex::new(WriterState {
@@ -873,22 +897,45 @@ impl MemberWriter {
                 written: from,
                 waiting: BTreeMap::new(),
                 records: kept,
-                last_sync: Instant::now(),
+                stop: false,
                 error: None,
             }),
             moved: std::sync::Condvar::new(),
+            dirty: std::sync::atomic::AtomicBool::new(false),
         };
-        (0..workers.max(1))
-            .into_par_iter()
-            .for_each(|_| w.work(total, window, run, progress));
+        let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
+        std::thread::scope(|scope| {
+            // The syncing thread: at most a second after a write, until the workers are done.
+            let w = &w;
+            scope.spawn(move || loop {
+                let last = !matches!(
+                    done_rx.recv_timeout(SYNC_EVERY),
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout)
+                );
+                if w.dirty.swap(false, Ordering::AcqRel) {
+                    if let Err(e) = syncing.sync_data() {
+                        let mut st = w.lock();
+                        st.stop = true;
+                        st.error
+                            .get_or_insert(crate::folder::output_error(&w.path, e));
+                        drop(st);
+                        w.moved.notify_all();
+                    }
+                }
+                if last {
+                    break;
+                }
+            });
+            let _done = done_tx;
+            (0..workers.max(1))
+                .into_par_iter()
+                .for_each(|_| w.work(total, window, run, progress));
+        });
         let mut st = w.state.into_inner().unwrap_or_else(|e| e.into_inner());
-        if let Some(e) = st.error.take() {
-            return Err(e);
+        match st.error.take() {
+            Some(e) => Err(e),
+            None => Ok(st.records),
         }
-        st.file
-            .sync_data()
-            .map_err(|e| crate::folder::output_error(&w.path, e))?;
-        Ok(st.records)
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, WriterState> {
@@ -903,13 +950,14 @@ impl MemberWriter {
         run: &(dyn Fn(usize) -> MemberRecord + Sync),
         progress: &(dyn Fn(usize, usize) + Sync),
     ) {
+        let _guard = StopOnPanic(self);
         loop {
             let k = {
                 let mut st = self.lock();
-                while st.error.is_none() && st.next < total && st.next >= st.written + window {
+                while !st.stop && st.next < total && st.next >= st.written + window {
                     st = self.moved.wait(st).unwrap_or_else(|e| e.into_inner());
                 }
-                if st.error.is_some() || st.next >= total {
+                if st.stop || st.next >= total {
                     return;
                 }
                 st.next += 1;
@@ -920,6 +968,7 @@ impl MemberWriter {
                 let mut st = self.lock();
                 st.waiting.insert(k, record);
                 if let Err(e) = self.write_ready(&mut st) {
+                    st.stop = true;
                     st.error.get_or_insert(e);
                 }
                 st.written
@@ -943,14 +992,11 @@ impl MemberWriter {
         if text.is_empty() {
             return Ok(());
         }
-        let err = |e| crate::folder::output_error(&self.path, e);
-        st.file.write_all(text.as_bytes()).map_err(err)?;
-        st.file.flush().map_err(err)?;
+        st.file
+            .write_all(text.as_bytes())
+            .map_err(|e| crate::folder::output_error(&self.path, e))?;
         st.written = next;
-        if st.last_sync.elapsed() >= SYNC_EVERY {
-            st.file.sync_data().map_err(err)?;
-            st.last_sync = Instant::now();
-        }
+        self.dirty.store(true, Ordering::Release);
         Ok(())
     }
 }
@@ -969,20 +1015,22 @@ fn manifest<'a>(
         complete,
         drops: if complete { members.len() } else { planned },
         failed: members.iter().filter(|m| m.class.is_none()).count(),
+        git_commit: Some(crate::build_info::GIT_COMMIT.to_string()),
         model_version: whirlmap_core::MODEL_VERSION,
         spec: SortedKeys(spec),
         threads: rayon::current_num_threads(),
         wall_time_s,
-        whirlmap_version: env!("CARGO_PKG_VERSION").to_string(),
+        whirlmap_version: crate::build_info::VERSION.to_string(),
     }
 }
 
 /// The members a `--resume` keeps from `out_dir`, and the length in bytes of
-/// `members.jsonl` they fill: every whole line from the start that reads as the record of the
-/// member at its position (cell `k / members`, member `k % members`, with the inputs and drawn
-/// values this spec gives it), up to the first that does not (a line cut short by a kill, say).
-/// Refused (exit 2) when the folder's manifest is not an ensemble's, is unreadable, or names
-/// another spec, model version or whirlmap version, or is missing while members are there.
+/// `members.jsonl` they fill: every whole line (a last line cut short by a kill is dropped),
+/// each of which must be the record of the member at its position (cell `k / members`, member
+/// `k % members`, with the inputs, drawn values and scene hash this spec gives it).
+/// Refused (exit 2) when a whole line is not that record, or the folder's manifest is not an
+/// ensemble's, is unreadable, names another spec, model version or build (whirlmap version and
+/// commit), or is missing while members are there.
 /// A folder with neither has nothing to keep.
 pub fn resumable_members(
     spec: &EnsembleSpec,
@@ -1036,11 +1084,18 @@ pub fn resumable_members(
             whirlmap_core::MODEL_VERSION
         )));
     }
-    if m.whirlmap_version != env!("CARGO_PKG_VERSION") {
+    let build = (m.whirlmap_version.as_str(), m.git_commit.as_deref());
+    if build
+        != (
+            crate::build_info::VERSION,
+            Some(crate::build_info::GIT_COMMIT),
+        )
+    {
         return Err(refuse(format!(
-            "its members were computed by whirlmap {}, this is {}",
-            m.whirlmap_version,
-            env!("CARGO_PKG_VERSION")
+            "its members were computed by whirlmap {}, this is {}: members of two builds \
+             would be mixed (resume it with that build)",
+            crate::build_info::describe(build.0, build.1.unwrap_or("?")),
+            crate::build_info::DESCRIPTION
         )));
     }
     let total = cells.len() * params.members;
@@ -1048,18 +1103,33 @@ pub fn resumable_members(
     let mut len = 0usize;
     for line in bytes.split_inclusive(|b| *b == b'\n') {
         let k = kept.len();
-        if k >= total || line.last() != Some(&b'\n') {
+        // A line cut short by a kill (no newline) is dropped; the run goes on from it.
+        if line.last() != Some(&b'\n') {
             break;
         }
-        let Ok(r) = serde_json::from_slice::<MemberRecord>(line) else {
-            break;
-        };
+        let place = format!("line {} of {MEMBERS_FILE}", k + 1);
+        if k >= total {
+            return Err(refuse(format!(
+                "{place} is one member more than the spec's {total}"
+            )));
+        }
+        let r = serde_json::from_slice::<MemberRecord>(line)
+            .map_err(|e| refuse(format!("{place} is not a member record ({e})")))?;
         let cell = &cells[k / params.members];
         let member = k % params.members;
-        let (_, drawn) = params.member_scene(&cell.scene, &cell.inputs, member);
-        if r.cell != cell.index || r.member != member || r.inputs != cell.inputs || r.drawn != drawn
-        {
-            break;
+        let (scene, drawn) = params.member_scene(&cell.scene, &cell.inputs, member);
+        let same = r.cell == cell.index
+            && r.member == member
+            && r.inputs == cell.inputs
+            && r.drawn == drawn
+            && r.scene_hash == scene.hash_hex();
+        if !same {
+            return Err(refuse(format!(
+                "{place} is not the member this spec runs there (cell {}, member {member}, \
+                 scene {})",
+                cell.index,
+                scene.hash_hex()
+            )));
         }
         kept.push(r);
         len += line.len();
@@ -1089,7 +1159,27 @@ pub fn run_ensemble_here(
         (Vec::new(), 0)
     };
     let resumed = kept.len();
-    // What an earlier run derived from its members is written anew at the end.
+    // First the members file, cut to what is kept (nothing, unless resuming); then the
+    // manifest that says which spec they belong to; then what an earlier run derived from its
+    // members goes (written anew at the end). A kill between any two steps leaves a folder
+    // whose manifest matches its members.
+    let members_path = out_dir.join(MEMBERS_FILE);
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .write(true)
+        .truncate(false)
+        .open(&members_path)
+        .and_then(|mut f| {
+            use std::io::Seek;
+            f.set_len(kept_len)?;
+            f.seek(std::io::SeekFrom::End(0))?;
+            f.sync_all()?;
+            Ok(f)
+        })
+        .map_err(|e| crate::folder::output_error(&members_path, e))?;
+    crate::folder::sync_dir(out_dir);
+    let m = manifest(spec, cells.len(), &[], false, total, 0.0);
+    crate::folder::write_atomic(&out_dir.join(MANIFEST_FILE), m.to_text().as_bytes())?;
     let mut written = Vec::new();
     for name in [CELLS_FILE, CELLS_CSV, CONTOURS_FILE] {
         let p = out_dir.join(name);
@@ -1100,24 +1190,6 @@ pub fn run_ensemble_here(
             _ => {}
         }
     }
-    let m = manifest(spec, cells.len(), &[], false, total, 0.0);
-    crate::folder::write_atomic(&out_dir.join(MANIFEST_FILE), m.to_text().as_bytes())?;
-    let members_path = out_dir.join(MEMBERS_FILE);
-    let file = std::fs::OpenOptions::new()
-        .create(true)
-        .write(true)
-        .truncate(false)
-        .open(&members_path)
-        .and_then(|f| {
-            f.set_len(kept_len)?;
-            Ok(f)
-        })
-        .and_then(|mut f| {
-            use std::io::Seek;
-            f.seek(std::io::SeekFrom::End(0))?;
-            Ok(f)
-        })
-        .map_err(|e| crate::folder::output_error(&members_path, e))?;
     let last = Mutex::new(Instant::now());
     let progress = |done: usize, total: usize| {
         if !show_progress {
@@ -1205,6 +1277,156 @@ pub fn run_ensemble_here(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A stand-in record for member `k`.
+    fn fake(k: usize) -> MemberRecord {
+        MemberRecord {
+            cell: k / 3,
+            member: k % 3,
+            inputs: Inputs(vec![("mu".into(), 0.1)]),
+            drawn: Drawn {
+                unbalance_m: 0.0,
+                unbalance_phase_rad: 0.0,
+                release_offset_m: [0.0; 2],
+                release_velocity_m_s: [0.0; 2],
+                race_speed_rad_s: 0.0,
+            },
+            scene_hash: format!("{k:016x}"),
+            class: None,
+            max_contact_force_n: Some(k as f64),
+            peak_heat_power_w: None,
+            error: None,
+        }
+    }
+
+    fn temp_file(name: &str) -> PathBuf {
+        let p = std::env::temp_dir().join(format!("whirlmap-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_file(&p);
+        p
+    }
+
+    /// Members of uneven cost, on four threads, while another task keeps one of the pool's
+    /// threads busy (as the critical search does beside a sweep's ensemble): the file holds
+    /// every record once, in order, after the kept ones.
+    #[test]
+    fn the_member_writer_appends_in_order_within_its_window() {
+        let path = temp_file("writer-order.jsonl");
+        let kept: Vec<MemberRecord> = (0..5).map(fake).collect();
+        let mut head = String::new();
+        for r in &kept {
+            head.push_str(&serde_json::to_string(r).unwrap());
+            head.push('\n');
+        }
+        std::fs::write(&path, &head).unwrap();
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .unwrap();
+        let running = AtomicUsize::new(0);
+        let furthest = AtomicUsize::new(0);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
+        let records = pool.install(|| {
+            let (records, _) = rayon::join(
+                || {
+                    MemberWriter::run(
+                        path.clone(),
+                        file,
+                        kept,
+                        200,
+                        4,
+                        &|k| {
+                            running.fetch_add(1, Ordering::SeqCst);
+                            furthest.fetch_max(k, Ordering::SeqCst);
+                            // Every seventh member is slow.
+                            let ms = if k % 7 == 0 { 3 } else { 0 };
+                            std::thread::sleep(Duration::from_millis(ms));
+                            running.fetch_sub(1, Ordering::SeqCst);
+                            fake(k)
+                        },
+                        &|done, total| assert!(done <= total),
+                    )
+                },
+                || std::thread::sleep(Duration::from_millis(50)),
+            );
+            records.unwrap()
+        });
+        assert_eq!(records, (0..200).map(fake).collect::<Vec<_>>());
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<MemberRecord> = text
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        assert_eq!(lines, records);
+        assert_eq!(running.load(Ordering::SeqCst), 0);
+        assert_eq!(furthest.load(Ordering::SeqCst), 199);
+        let _ = std::fs::remove_file(&path);
+    }
+
+    /// A file that cannot be written stops the workers (no hang) and the error comes back.
+    #[test]
+    fn a_write_error_stops_the_members_and_is_returned() {
+        let path = temp_file("writer-error.jsonl");
+        std::fs::write(&path, "").unwrap();
+        let read_only = std::fs::File::open(&path).unwrap();
+        let ran = AtomicUsize::new(0);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let r = pool.install(|| {
+            MemberWriter::run(
+                path.clone(),
+                read_only,
+                Vec::new(),
+                10_000,
+                2,
+                &|k| {
+                    ran.fetch_add(1, Ordering::SeqCst);
+                    fake(k)
+                },
+                &|_, _| {},
+            )
+        });
+        assert!(matches!(r, Err(SweepError::Io { .. })), "{r:?}");
+        // At most the members in flight when the first write failed, and the window.
+        assert!(ran.load(Ordering::SeqCst) <= 2 + WINDOW_PER_THREAD * 2);
+        let _ = std::fs::remove_file(&path);
+    }
+
+    /// A panic in one member stops the others and reaches the caller instead of leaving
+    /// the waiting workers blocked.
+    #[test]
+    fn a_panicking_member_is_re_raised_not_waited_for() {
+        let path = temp_file("writer-panic.jsonl");
+        let file = std::fs::File::create(&path).unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            pool.install(|| {
+                MemberWriter::run(
+                    path.clone(),
+                    file,
+                    Vec::new(),
+                    1000,
+                    2,
+                    &|k| {
+                        if k == 3 {
+                            panic!("member 3");
+                        }
+                        fake(k)
+                    },
+                    &|_, _| {},
+                )
+            })
+        }));
+        assert!(r.is_err());
+        let _ = std::fs::remove_file(&path);
+    }
 
     #[test]
     fn wilson_matches_hand_computed_values() {
