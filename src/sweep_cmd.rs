@@ -30,8 +30,9 @@ pub struct SweepArgs {
     /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub(crate) threads: Option<u32>,
-    /// Continue the run in the output folder: keep its ok points and run only the rest. Only
-    /// a run of the same spec (and shard) by the same build is continued.
+    /// Continue the run in the output folder: keep its ok points, its finished critical
+    /// search, orbits and probability members, and run only the rest. Only a run of the same
+    /// spec (and shard) by the same build is continued.
     #[arg(long, conflicts_with = "overwrite")]
     pub(crate) resume: bool,
     /// Replace the results already in the output folder (they are moved to `previous-run/`

@@ -498,3 +498,81 @@ fn a_resumed_sweep_keeps_the_members_its_probability_ensemble_wrote() {
     assert_eq!(read_json(&p.join("manifest.json"))["complete"], true);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A resumed sweep keeps the critical search and the orbits a killed run finished, and runs
+/// again a critical row that failed drops left undecided. Marked records show which: a kept
+/// file keeps its mark, a rerun one loses it.
+#[test]
+fn a_resumed_sweep_keeps_the_finished_critical_search_and_orbits() {
+    let dir = temp_dir("resume-extras");
+    let spec = spec_file(
+        &dir,
+        "x.json",
+        r#"{"name": "x", "duration_s": 0.1,
+            "axes": {"speed_rpm": [4000], "mu": [0.3]},
+            "critical": {"mu": [0.3, 0.4], "speed_rpm": {"from": 2000, "to": 6000},
+              "resolution_rpm": 2000, "tol_rpm": 500},
+            "orbits": {"speed_rpm": 4000, "mu": [0.1, 0.3]}}"#,
+    );
+    let (full, killed) = (dir.join("full"), dir.join("killed"));
+    for out in [&full, &killed] {
+        let o = whirlmap(&["sweep", s(&spec), "--out", s(out), "--no-progress"]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    }
+    let critical = killed.join("critical.json");
+    let text = std::fs::read_to_string(&critical).unwrap();
+    let marked = text.replacen("\"note\": \"", "\"note\": \"KEPT ", 1);
+    assert_ne!(marked, text);
+    std::fs::write(&critical, &marked).unwrap();
+    let orbits: Vec<PathBuf> = {
+        let mut v: Vec<PathBuf> = std::fs::read_dir(killed.join("orbits"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(orbits.len(), 2, "{orbits:?}");
+    // The first orbit is kept (marked); the second is missing, as if killed before it.
+    let first = std::fs::read_to_string(&orbits[0]).unwrap();
+    let first_marked = first.replacen('{', "{\"kept\": true, ", 1);
+    std::fs::write(&orbits[0], &first_marked).unwrap();
+    std::fs::remove_file(&orbits[1]).unwrap();
+
+    let resume = || {
+        let o = whirlmap(&[
+            "sweep",
+            s(&spec),
+            "--out",
+            s(&killed),
+            "--resume",
+            "--no-progress",
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    };
+    resume();
+    assert_eq!(
+        std::fs::read_to_string(&critical).unwrap(),
+        marked,
+        "critical.json kept"
+    );
+    assert!(std::fs::read_to_string(killed.join("critical.csv"))
+        .unwrap()
+        .contains("KEPT"));
+    assert_eq!(std::fs::read_to_string(&orbits[0]).unwrap(), first_marked);
+    let second = full.join("orbits").join(orbits[1].file_name().unwrap());
+    assert_eq!(
+        std::fs::read(&orbits[1]).unwrap(),
+        std::fs::read(second).unwrap()
+    );
+
+    // A row left undecided by failed drops is run again: the mark goes.
+    let undecided = marked.replacen("\"from_rpm\"", "\"undecided\": true,\n    \"from_rpm\"", 1);
+    std::fs::write(&critical, &undecided).unwrap();
+    resume();
+    assert_eq!(
+        std::fs::read(&critical).unwrap(),
+        std::fs::read(full.join("critical.json")).unwrap()
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -83,8 +83,9 @@ pub fn run_all(
 /// and the orbit panels at positions `i` for which `owns` is true, and the probability
 /// ensemble when `owns(0)` (it is one job). When more than one fails, the error reported is
 /// the critical search's, then the orbits', then the ensemble's. With `resume` (a sweep's
-/// `--resume`), the ensemble keeps the members its folder already holds
-/// ([`crate::ensemble::run_ensemble`]); the critical search and the orbits run anew.
+/// `--resume` of the same spec and build), what the killed run finished is kept: a
+/// `critical.json` with a decided row for every friction coefficient the run owns, each orbit
+/// file, and the ensemble's members ([`crate::ensemble::run_ensemble`]); the rest runs.
 pub fn run_all_owned(
     spec: &SweepSpec,
     out_dir: &Path,
@@ -103,8 +104,8 @@ pub fn run_all_owned(
         let ((critical, orbits), probability) = rayon::join(
             || {
                 let both = rayon::join(
-                    || run_critical_ticked(spec, out_dir, &owns, &ticker),
-                    || record_orbits_ticked(spec, out_dir, &owns, &ticker),
+                    || run_critical_ticked(spec, out_dir, &owns, &ticker, resume),
+                    || record_orbits_ticked(spec, out_dir, &owns, &ticker, resume),
                 );
                 ticker.finish();
                 both
@@ -177,15 +178,17 @@ pub fn run_critical_owned(
     out_dir: &Path,
     owns: impl Fn(usize) -> bool,
 ) -> Result<Option<PathBuf>, ExtrasError> {
-    run_critical_ticked(spec, out_dir, owns, &Ticker::off())
+    run_critical_ticked(spec, out_dir, owns, &Ticker::off(), false)
 }
 
-/// [`run_critical_owned`], counting its drops on `ticker`.
+/// [`run_critical_owned`], counting its drops on `ticker`. With `resume`, a `critical.json`
+/// already in `out_dir` ([`kept_critical`]) is kept and nothing runs.
 fn run_critical_ticked(
     spec: &SweepSpec,
     out_dir: &Path,
     owns: impl Fn(usize) -> bool,
     ticker: &Ticker,
+    resume: bool,
 ) -> Result<Option<PathBuf>, ExtrasError> {
     let Some(c) = &spec.critical else {
         return Ok(None);
@@ -194,6 +197,9 @@ fn run_critical_ticked(
         .filter(|(j, _)| owns(*j))
         .map(|(_, mu)| mu)
         .collect();
+    if let Some(rows) = resume.then(|| kept_critical(out_dir, &mus)).flatten() {
+        return write_critical(out_dir, &rows);
+    }
     let rows = if mus.is_empty() {
         Vec::new()
     } else {
@@ -207,6 +213,21 @@ fn run_critical_ticked(
         .expect("the spec's critical section was validated")
     };
     write_critical(out_dir, &rows)
+}
+
+/// The rows of the `critical.json` a killed run of the same spec and build left in `out_dir`,
+/// when it has one row per friction coefficient of `mus`, in that order, and every onset is
+/// decided (a row that failed drops left undecided runs again, as a failed grid point does).
+/// `critical.json` is written whole or not at all, so a file that is there is a finished
+/// search.
+fn kept_critical(out_dir: &Path, mus: &[f64]) -> Option<Vec<CriticalRow>> {
+    let rows = whirlmap_results::critical::read_critical(out_dir).ok()??;
+    let same_mus = rows.len() == mus.len()
+        && rows
+            .iter()
+            .zip(mus)
+            .all(|(r, mu)| r.mu.to_bits() == mu.to_bits());
+    (same_mus && rows.iter().all(|r| !r.undecided)).then_some(rows)
 }
 
 /// Writes `rows` as `critical.json` and `critical.csv` in `out_dir`; returns the JSON file.
@@ -259,25 +280,34 @@ pub fn record_orbits_owned(
     out_dir: &Path,
     owns: impl Fn(usize) -> bool,
 ) -> Result<Vec<PathBuf>, ExtrasError> {
-    record_orbits_ticked(spec, out_dir, owns, &Ticker::off())
+    record_orbits_ticked(spec, out_dir, owns, &Ticker::off(), false)
 }
 
-/// [`record_orbits_owned`], counting its drops on `ticker`.
+/// [`record_orbits_owned`], counting its drops on `ticker`. With `resume`, a panel whose
+/// orbit file is already in `out_dir` (written whole or not at all) is kept; a panel whose
+/// drop failed runs again.
 fn record_orbits_ticked(
     spec: &SweepSpec,
     out_dir: &Path,
     owns: impl Fn(usize) -> bool,
     ticker: &Ticker,
+    resume: bool,
 ) -> Result<Vec<PathBuf>, ExtrasError> {
     let Some((speed, mus)) = orbit_panels(spec) else {
         return Ok(Vec::new());
     };
-    let panels: Vec<(usize, f64)> = mus
-        .iter()
-        .copied()
-        .enumerate()
-        .filter(|(i, _)| owns(*i))
-        .collect();
+    let stem = |i: usize, mu: f64| format!("{i:02}_{speed:.0}rpm_mu{mu:.3}");
+    let mut written = Vec::new();
+    let mut panels: Vec<(usize, f64)> = Vec::new();
+    for (i, mu) in mus.iter().copied().enumerate().filter(|(i, _)| owns(*i)) {
+        let path = out_dir.join(ORBITS_DIR).join(orbit_file(&stem(i, mu)));
+        if resume && path.is_file() {
+            ticker.tick();
+            written.push(path);
+        } else {
+            panels.push((i, mu));
+        }
+    }
     let runs: Vec<_> = panels
         .par_iter()
         .map(|&(i, mu)| {
@@ -294,9 +324,9 @@ fn record_orbits_ticked(
             (i, mu, run)
         })
         .collect();
-    let mut written = Vec::new();
     for (i, mu, run) in runs {
-        let stem = format!("{i:02}_{speed:.0}rpm_mu{mu:.3}");
+        let stem = stem(i, mu);
+        let error_file = out_dir.join(ORBITS_DIR).join(orbit_error_file(&stem));
         match run {
             // Drops asked for orbit points always record an orbit.
             Ok(r) if r.orbit.is_some() => {
@@ -304,17 +334,22 @@ fn record_orbits_ticked(
                 let doc = OrbitFile::new(speed, mu, r.verdict.class, orbit);
                 let path = out_dir.join(ORBITS_DIR).join(orbit_file(&stem));
                 write(&path, &doc.to_json())?;
+                // A resumed panel that failed before and now has its orbit.
+                if let Err(e) = std::fs::remove_file(&error_file) {
+                    if e.kind() != std::io::ErrorKind::NotFound {
+                        return Err(ExtrasError::Io {
+                            path: error_file,
+                            source: e,
+                        });
+                    }
+                }
                 written.push(path);
             }
-            Ok(_) => {
-                let path = out_dir.join(ORBITS_DIR).join(orbit_error_file(&stem));
-                write(&path, "no orbit was recorded\n")?;
-            }
-            Err(e) => {
-                let path = out_dir.join(ORBITS_DIR).join(orbit_error_file(&stem));
-                write(&path, &format!("{e}\n"))?;
-            }
+            Ok(_) => write(&error_file, "no orbit was recorded\n")?,
+            Err(e) => write(&error_file, &format!("{e}\n"))?,
         }
     }
+    // Panel order, kept ones among them.
+    written.sort();
     Ok(written)
 }

@@ -11,8 +11,9 @@
 //! ## What a run owns
 //! Every name in [`OWNED`] is whirlmap's. A new run into a folder that holds any of them is
 //! refused (exit 2) unless it is told `--resume` (the same spec and build: the records are
-//! kept, and so are the probability ensemble's members in `probability/`; every other
-//! derived file is removed and made again) or `--overwrite` (the old files are
+//! kept, and so are what the extras finished: `critical.json`, the orbit files and the
+//! probability ensemble's members, [`crate::extras::run_all_owned`]; every other derived
+//! file is removed and made again) or `--overwrite` (the old files are
 //! moved into [`PREVIOUS_DIR`] and deleted once the new run's first records are synced to
 //! disk, so a rerun killed early loses nothing). Other files are left alone and never read.
 //!
@@ -67,9 +68,7 @@ pub const OWNED: &[&str] = &[
 const DERIVED: &[&str] = &[
     SUMMARY_FILE,
     BEARING_REPORT_FILE,
-    CRITICAL_FILE,
     CRITICAL_CSV_FILE,
-    ORBITS_DIR,
     CHARTS_DIR,
     COMPARE_REPORT_FILE,
     COMPARE_CLASSES_FILE,
