@@ -229,41 +229,17 @@ const KILL_SPEC: &str = r#"{"name": "kill", "duration_s": 1.0,
 /// Runs `whirlmap ensemble spec --out out` on two threads and kills it once `members.jsonl`
 /// holds two records (and before it holds all 40).
 fn kill_after_two_members(spec: &Path, out: &Path) {
-    use std::process::{Command, Stdio};
-    use std::time::{Duration, Instant};
-    let mut child = Command::new(BIN)
-        .args([
-            "ensemble",
-            s(spec),
-            "--out",
-            s(out),
-            "--threads",
-            "2",
-            "--no-progress",
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let members = out.join("members.jsonl");
-    let start = Instant::now();
-    loop {
-        let n = std::fs::read_to_string(&members)
-            .map(|t| t.matches('\n').count())
-            .unwrap_or(0);
-        if n >= 2 {
-            assert!(n < 40, "the ensemble finished before it could be killed");
-            child.kill().unwrap();
-            break;
-        }
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "ended before 2 members"
-        );
-        assert!(start.elapsed() < Duration::from_secs(120), "no progress");
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    child.wait().unwrap();
+    let args = [
+        "ensemble",
+        s(spec),
+        "--out",
+        s(out),
+        "--threads",
+        "2",
+        "--no-progress",
+    ];
+    let n = kill_after_lines(&args, &out.join("members.jsonl"), 2);
+    assert!(n < 40, "the ensemble finished before it could be killed");
 }
 
 #[test]

@@ -6,8 +6,7 @@ mod common;
 use common::*;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Output;
 
 /// 9 grid points, 3 critical searches, 2 orbit panels, a probability ensemble, every chart:
 /// with 4 shards the parts are uneven (3, 2, 2, 2 points), shard 3 owns no critical search
@@ -334,42 +333,21 @@ fn a_killed_shard_is_reported_then_resumes_without_duplicates_or_losses() {
     // Shard 0 again, killed once some of its records are in (its 3 points run on one thread;
     // its critical search, about 17 drops, and its orbit panel are still to go).
     let killed = dir.join("killed-0");
-    let mut child = Command::new(BIN)
-        .args([
-            "sweep",
-            s(&spec),
-            "--shard",
-            "0",
-            "--shards",
-            "4",
-            "--out",
-            s(&killed),
-            "--threads",
-            "1",
-            "--no-progress",
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let args = [
+        "sweep",
+        s(&spec),
+        "--shard",
+        "0",
+        "--shards",
+        "4",
+        "--out",
+        s(&killed),
+        "--threads",
+        "1",
+        "--no-progress",
+    ];
     let points = killed.join("points.jsonl");
-    let start = Instant::now();
-    loop {
-        let n = std::fs::read_to_string(&points)
-            .map(|t| t.lines().count())
-            .unwrap_or(0);
-        if n >= 1 {
-            child.kill().unwrap();
-            break;
-        }
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "the shard ended before writing"
-        );
-        assert!(start.elapsed() < Duration::from_secs(120), "no progress");
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    child.wait().unwrap();
+    kill_after_lines(&args, &points, 1);
     assert!(
         !killed.join("critical.json").exists(),
         "the shard finished before it could be killed"

@@ -5,8 +5,6 @@ mod common;
 use common::*;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
 fn smoke_spec() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/smoke.json")
@@ -180,42 +178,21 @@ fn points_are_byte_identical_for_any_thread_count() {
 /// Runs `whirlmap sweep spec --out out` on `threads` threads and kills it as soon as two
 /// records are in `points.jsonl` (and before `grid_size` are); returns that file's path.
 fn kill_after_two_lines(spec: &Path, out: &Path, threads: &str, grid_size: usize) -> PathBuf {
-    let mut child = Command::new(BIN)
-        .args([
-            "sweep",
-            s(spec),
-            "--out",
-            s(out),
-            "--threads",
-            threads,
-            "--no-progress",
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let args = [
+        "sweep",
+        s(spec),
+        "--out",
+        s(out),
+        "--threads",
+        threads,
+        "--no-progress",
+    ];
     let points = out.join("points.jsonl");
-    let start = Instant::now();
-    loop {
-        let n = std::fs::read_to_string(&points)
-            .map(|t| t.matches('\n').count())
-            .unwrap_or(0);
-        if n >= 2 {
-            assert!(
-                n < grid_size,
-                "the sweep finished before it could be killed"
-            );
-            child.kill().unwrap();
-            break;
-        }
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "the sweep ended before writing 2 lines"
-        );
-        assert!(start.elapsed() < Duration::from_secs(60), "no progress");
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    child.wait().unwrap();
+    let n = kill_after_lines(&args, &points, 2);
+    assert!(
+        n < grid_size,
+        "the sweep finished before it could be killed"
+    );
     points
 }
 

@@ -76,6 +76,38 @@ pub fn whirlmap_within<S: AsRef<OsStr>>(args: &[S], limit: std::time::Duration) 
     }
 }
 
+/// Runs `whirlmap` with `args` and kills it (SIGKILL) as soon as `file` holds `lines` complete
+/// lines; returns how many it held then. Fails the test if the command ends first or writes
+/// nothing for two minutes.
+pub fn kill_after_lines<S: AsRef<OsStr>>(args: &[S], file: &Path, lines: usize) -> usize {
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let mut child = Command::new(BIN)
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("runs the binary");
+    let start = Instant::now();
+    loop {
+        let n = std::fs::read_to_string(file)
+            .map(|t| t.matches('\n').count())
+            .unwrap_or(0);
+        if n >= lines {
+            child.kill().expect("kills the run");
+            child.wait().expect("waits");
+            return n;
+        }
+        assert!(
+            child.try_wait().expect("waits").is_none(),
+            "the run ended before writing {lines} lines to {}",
+            file.display()
+        );
+        assert!(start.elapsed() < Duration::from_secs(120), "no progress");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
 /// Writes a sweep spec `text` to `dir/<name>.json` and returns its path.
 pub fn spec_file(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(format!("{name}.json"));
