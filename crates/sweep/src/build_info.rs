@@ -21,3 +21,10 @@ pub const DESCRIPTION: &str = concat!(
 pub fn describe(version: &str, commit: &str) -> String {
     format!("{version} (commit {commit})")
 }
+
+/// The recorded build (`version`, `commit`; `None` where a manifest has no such key),
+/// described as [`describe`] does, when it is not this one; `None` when it is.
+pub fn other_build(version: Option<&str>, commit: Option<&str>) -> Option<String> {
+    (version != Some(VERSION) || commit != Some(GIT_COMMIT))
+        .then(|| describe(version.unwrap_or("?"), commit.unwrap_or("?")))
+}

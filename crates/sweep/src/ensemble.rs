@@ -849,11 +849,9 @@ struct WriterState {
     file: std::fs::File,
     /// The next member not yet taken by a worker.
     next: usize,
-    /// Members written (all of `0..written`, in `records`).
-    written: usize,
     /// Done members waiting for one before them.
     waiting: BTreeMap<usize, MemberRecord>,
-    /// Every record written, resumed ones first.
+    /// Every record written, resumed ones first: members `0..records.len()`.
     records: Vec<MemberRecord>,
     /// Take no more members: an error (kept here) or a panic.
     stop: bool,
@@ -894,7 +892,6 @@ impl MemberWriter {
             state: Mutex::new(WriterState {
                 file,
                 next: from,
-                written: from,
                 waiting: BTreeMap::new(),
                 records: kept,
                 stop: false,
@@ -954,7 +951,7 @@ impl MemberWriter {
         loop {
             let k = {
                 let mut st = self.lock();
-                while !st.stop && st.next < total && st.next >= st.written + window {
+                while !st.stop && st.next < total && st.next >= st.records.len() + window {
                     st = self.moved.wait(st).unwrap_or_else(|e| e.into_inner());
                 }
                 if st.stop || st.next >= total {
@@ -971,7 +968,7 @@ impl MemberWriter {
                     st.stop = true;
                     st.error.get_or_insert(e);
                 }
-                st.written
+                st.records.len()
             };
             self.moved.notify_all();
             progress(done, total);
@@ -982,12 +979,10 @@ impl MemberWriter {
     fn write_ready(&self, st: &mut WriterState) -> Result<(), SweepError> {
         use std::io::Write;
         let mut text = String::new();
-        let mut next = st.written;
-        while let Some(r) = st.waiting.remove(&next) {
+        while let Some(r) = st.waiting.remove(&st.records.len()) {
             text.push_str(&serde_json::to_string(&r).expect("records serialise"));
             text.push('\n');
             st.records.push(r);
-            next += 1;
         }
         if text.is_empty() {
             return Ok(());
@@ -995,26 +990,25 @@ impl MemberWriter {
         st.file
             .write_all(text.as_bytes())
             .map_err(|e| crate::folder::output_error(&self.path, e))?;
-        st.written = next;
         self.dirty.store(true, Ordering::Release);
         Ok(())
     }
 }
 
 /// The manifest of a run of `spec` over `cells`.
-fn manifest<'a>(
-    spec: &'a EnsembleSpec,
+fn manifest(
+    spec: &EnsembleSpec,
     cells: usize,
-    members: &[MemberRecord],
+    drops: usize,
+    failed: usize,
     complete: bool,
-    planned: usize,
     wall_time_s: f64,
-) -> EnsembleManifest<&'a EnsembleSpec> {
+) -> EnsembleManifest<&EnsembleSpec> {
     EnsembleManifest {
         cells,
         complete,
-        drops: if complete { members.len() } else { planned },
-        failed: members.iter().filter(|m| m.class.is_none()).count(),
+        drops,
+        failed,
         git_commit: Some(crate::build_info::GIT_COMMIT.to_string()),
         model_version: whirlmap_core::MODEL_VERSION,
         spec: SortedKeys(spec),
@@ -1084,17 +1078,12 @@ pub fn resumable_members(
             whirlmap_core::MODEL_VERSION
         )));
     }
-    let build = (m.whirlmap_version.as_str(), m.git_commit.as_deref());
-    if build
-        != (
-            crate::build_info::VERSION,
-            Some(crate::build_info::GIT_COMMIT),
-        )
+    if let Some(old) =
+        crate::build_info::other_build(Some(&m.whirlmap_version), m.git_commit.as_deref())
     {
         return Err(refuse(format!(
-            "its members were computed by whirlmap {}, this is {}: members of two builds \
+            "its members were computed by whirlmap {old}, this is {}: members of two builds \
              would be mixed (resume it with that build)",
-            crate::build_info::describe(build.0, build.1.unwrap_or("?")),
             crate::build_info::DESCRIPTION
         )));
     }
@@ -1178,7 +1167,7 @@ pub fn run_ensemble_here(
         })
         .map_err(|e| crate::folder::output_error(&members_path, e))?;
     crate::folder::sync_dir(out_dir);
-    let m = manifest(spec, cells.len(), &[], false, total, 0.0);
+    let m = manifest(spec, cells.len(), total, 0, false, 0.0);
     crate::folder::write_atomic(&out_dir.join(MANIFEST_FILE), m.to_text().as_bytes())?;
     let mut written = Vec::new();
     for name in [CELLS_FILE, CELLS_CSV, CONTOURS_FILE] {
@@ -1253,15 +1242,15 @@ pub fn run_ensemble_here(
         &format!("{text}\n"),
         &mut written,
     )?;
+    let failed = members.iter().filter(|m| m.class.is_none()).count();
     let m = manifest(
         spec,
         cells.len(),
-        &members,
-        true,
         total,
+        failed,
+        true,
         start.elapsed().as_secs_f64(),
     );
-    let failed = m.failed;
     write_file(&out_dir.join(MANIFEST_FILE), &m.to_text(), &mut written)?;
     Ok(EnsembleOutcome {
         cells: cells.len(),

@@ -505,19 +505,12 @@ fn check_resumable(dir: &Path, id: &RunIdentity) -> Result<(), SweepError> {
             }
         )));
     }
-    let old_build = (m.whirlmap_version.clone(), m.git_commit.clone());
-    let this = (
-        Some(crate::build_info::VERSION.to_string()),
-        Some(crate::build_info::GIT_COMMIT.to_string()),
-    );
-    if old_build != this {
+    if let Some(old) =
+        crate::build_info::other_build(m.whirlmap_version.as_deref(), m.git_commit.as_deref())
+    {
         return Err(refuse(format!(
-            "it was started by whirlmap {}, this is {}: records of two builds would be mixed \
+            "it was started by whirlmap {old}, this is {}: records of two builds would be mixed \
              (resume it with that build)",
-            crate::build_info::describe(
-                old_build.0.as_deref().unwrap_or("?"),
-                old_build.1.as_deref().unwrap_or("?")
-            ),
             crate::build_info::DESCRIPTION
         )));
     }
