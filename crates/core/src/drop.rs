@@ -8,7 +8,7 @@ use crate::model::{ix, DropSystem, Mode, N};
 use crate::monitor::{Features, Monitor, WhirlDecided};
 use crate::ode::{
     run_hybrid, Dop853, Dopri5, Finish, HybridObserver, JumpRules, NoObserver, Observer, Rodas4,
-    Ros34pw2, Stats, StepControl, StepView, Stepper,
+    Rodas5p, Ros34pw2, Stats, StepControl, StepView, Stepper,
 };
 use crate::orbit::Orbit;
 use crate::scene::{Method, Scene};
@@ -433,6 +433,7 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
         Method::Dop853 => run_with(scene, opts, extra, sys, Dop853::new(ctl)),
         Method::Ros34pw2 => run_with(scene, opts, extra, sys, Ros34pw2::new(ctl)),
         Method::Rodas4 => run_with(scene, opts, extra, sys, Rodas4::new(ctl)),
+        Method::Rodas5p => run_with(scene, opts, extra, sys, Rodas5p::new(ctl)),
     }
 }
 

@@ -47,6 +47,18 @@ pub enum Method {
     /// default).
     #[default]
     Rodas4,
+    /// Rodas5P, a Rosenbrock method of order 5 (Steinebach 2023) on the full Jacobian and
+    /// the factors of RODAS4 (`ode/rodas5p.rs`).
+    Rodas5p,
+}
+
+impl Method {
+    /// Whether the stepper is a Rosenbrock method, whose order needs the model's exact
+    /// Jacobian (every term: the energy integrals' rows, the sticking constraint's slopes, the
+    /// drag's), rather than a W-method's stiff approximation or none.
+    pub fn needs_exact_jacobian(self) -> bool {
+        matches!(self, Method::Rodas4 | Method::Rodas5p)
+    }
 }
 
 /// How the race-on-balls damper c2 of Table 4 acts on the race's velocity.
@@ -96,7 +108,8 @@ pub struct SolverSettings {
     /// Jacobian, whose step is not bounded by the light race's contact modes (the `standard`
     /// fidelity's); `dopri5`, the explicit Dormand-Prince 5(4) pair (the `reference`
     /// fidelity's); `ros34pw2`, the 3rd-order Rosenbrock-W method (the `draft` fidelity's);
-    /// `dop853` the independent reference of `whirlmap accuracy`.
+    /// `dop853` the independent reference of `whirlmap accuracy`; `rodas5p`, the 5th-order
+    /// Rosenbrock method on RODAS4's Jacobian, for tolerances of 1e-6 and tighter.
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a

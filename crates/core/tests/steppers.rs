@@ -14,8 +14,8 @@
 //! the last test shows). The observed orders and slopes print with `--nocapture`.
 
 use whirlmap_core::ode::{
-    integrate, Dop853, Dopri5, NoGuard, NoObserver, OdeSystem, Rodas4, Ros34pw2, StepControl,
-    Stepper, StiffJacobian, Stop,
+    integrate, Dop853, Dopri5, NoGuard, NoObserver, OdeSystem, Rodas4, Rodas5p, Ros34pw2,
+    StepControl, Stepper, StiffJacobian, Stop,
 };
 
 /// A reference problem: a two-component system with its exact solution.
@@ -28,6 +28,10 @@ trait Reference: OdeSystem<2, Guard = NoGuard> {
     fn exact(&self, t: f64) -> [f64; 2];
     /// The time the runs end at.
     fn t_end(&self) -> f64;
+    /// Whether the system is linear (its error then shows the stability function's order).
+    fn linear(&self) -> bool {
+        true
+    }
 }
 
 /// y0' = -2 y0, y1' = -y1 / 2: exp(-2 t), exp(-t / 2).
@@ -135,11 +139,53 @@ impl Reference for StiffLinear {
     }
 }
 
+/// Two logistic equations, y0' = y0 (1 - y0) and y1' = y1 (1 - y1) / 2 from (0.1, 0.2):
+/// `1 / (1 + 9 e^-t)` and `1 / (1 + 4 e^(-t/2))`. Nonlinear, unlike the problems above: on a
+/// linear problem a Rosenbrock method's error is that of its stability function, whose order
+/// can exceed the method's (Rodas5P's matches `e^z` to order 6).
+struct Logistic;
+impl OdeSystem<2> for Logistic {
+    type Guard = NoGuard;
+    fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+        dy[0] = y[0] * (1.0 - y[0]);
+        dy[1] = 0.5 * y[1] * (1.0 - y[1]);
+    }
+    fn stiff_jacobian(&self, _t: f64, y: &[f64; 2]) -> Option<StiffJacobian> {
+        let mut s = StiffJacobian::over(&[0, 1]);
+        s.jac[(0, 0)] = 1.0 - 2.0 * y[0];
+        s.jac[(1, 1)] = 0.5 * (1.0 - 2.0 * y[1]);
+        Some(s)
+    }
+}
+impl Reference for Logistic {
+    fn name(&self) -> &'static str {
+        "logistic equations"
+    }
+    fn y0(&self) -> [f64; 2] {
+        [0.1, 0.2]
+    }
+    fn exact(&self, t: f64) -> [f64; 2] {
+        [
+            1.0 / (1.0 + 9.0 * (-t).exp()),
+            1.0 / (1.0 + 4.0 * (-0.5 * t).exp()),
+        ]
+    }
+    fn t_end(&self) -> f64 {
+        4.0
+    }
+    fn linear(&self) -> bool {
+        false
+    }
+}
+
 /// A stepper under test: how to make one, its order, the fixed steps at which its error is
 /// well above rounding and well inside the asymptotic range, and the tolerances to sweep.
 struct Method {
     name: &'static str,
     order: f64,
+    /// The order of its stability function's match to `e^z`: the order it shows on the
+    /// linear problems (at least `order`).
+    linear_order: f64,
     make: fn(StepControl<2>) -> Box<dyn StepperBox>,
     /// Fixed step counts over `t_end`: the order is measured between `n` and `2 n`.
     steps: usize,
@@ -167,6 +213,7 @@ enum Problem<'a> {
     Decay(&'a Decay),
     Harmonic(&'a Harmonic),
     Stiff(&'a StiffLinear),
+    Logistic(&'a Logistic),
 }
 
 impl ReferenceDyn for Decay {
@@ -182,6 +229,11 @@ impl ReferenceDyn for Harmonic {
 impl ReferenceDyn for StiffLinear {
     fn reference(&self) -> Problem<'_> {
         Problem::Stiff(self)
+    }
+}
+impl ReferenceDyn for Logistic {
+    fn reference(&self) -> Problem<'_> {
+        Problem::Logistic(self)
     }
 }
 
@@ -200,15 +252,17 @@ impl<M: Stepper<2>> StepperBox for M {
             Problem::Decay(p) => run_to_end(self, p),
             Problem::Harmonic(p) => run_to_end(self, p),
             Problem::Stiff(p) => run_to_end(self, p),
+            Problem::Logistic(p) => run_to_end(self, p),
         }
     }
 }
 
-fn methods() -> [Method; 4] {
+fn methods() -> [Method; 5] {
     [
         Method {
             name: "DOPRI5",
             order: 5.0,
+            linear_order: 5.0,
             make: |c| Box::new(Dopri5::new(c)),
             steps: 40,
             rtols: [1e-4, 1e-7, 1e-10],
@@ -218,6 +272,7 @@ fn methods() -> [Method; 4] {
         Method {
             name: "DOP853",
             order: 8.0,
+            linear_order: 8.0,
             make: |c| Box::new(Dop853::new(c)),
             steps: 10,
             rtols: [1e-6, 1e-9, 1e-12],
@@ -227,6 +282,7 @@ fn methods() -> [Method; 4] {
         Method {
             name: "ROS34PW2",
             order: 3.0,
+            linear_order: 3.0,
             make: |c| Box::new(Ros34pw2::new(c)),
             steps: 200,
             rtols: [1e-4, 1e-6, 1e-8],
@@ -236,11 +292,22 @@ fn methods() -> [Method; 4] {
         Method {
             name: "RODAS4",
             order: 4.0,
+            linear_order: 4.0,
             make: |c| Box::new(Rodas4::new(c)),
             steps: 100,
             rtols: [1e-4, 1e-6, 1e-8],
             implicit: true,
             // A Rosenbrock method: its order needs the exact Jacobian (see the test below).
+            w_method: false,
+        },
+        Method {
+            name: "Rodas5P",
+            order: 5.0,
+            linear_order: 6.0,
+            make: |c| Box::new(Rodas5p::new(c)),
+            steps: 20,
+            rtols: [1e-4, 1e-7, 1e-10],
+            implicit: true,
             w_method: false,
         },
     ]
@@ -253,6 +320,7 @@ struct Case {
     problem: Box<dyn ReferenceDyn>,
     exact: [f64; 2],
     t_end: f64,
+    linear: bool,
 }
 
 impl Case {
@@ -261,6 +329,7 @@ impl Case {
             name: p.name(),
             exact: p.exact(p.t_end()),
             t_end: p.t_end(),
+            linear: p.linear(),
             problem: Box::new(p),
         }
     }
@@ -298,8 +367,11 @@ fn fixed_steps_converge_at_each_methods_order() {
             problem: p,
             exact,
             t_end,
+            linear,
         } in problems(&m)
         {
+            // Every problem here is linear but the nonlinear one of the next test.
+            let expected = if linear { m.linear_order } else { m.order };
             let err_at = |n: usize| {
                 let ctl = StepControl {
                     rtol: 1.0,
@@ -314,12 +386,41 @@ fn fixed_steps_converge_at_each_methods_order() {
             let order = (e1 / e2).log2();
             println!("{} on {name}: observed order {order:.2}", m.name);
             assert!(
-                (order - m.order).abs() < 0.1 * m.order,
-                "{} on {name}: observed order {order:.2}, expected {} ({e1:e} -> {e2:e})",
+                (order - expected).abs() < 0.1 * expected,
+                "{} on {name}: observed order {order:.2}, expected {expected} ({e1:e} -> {e2:e})",
                 m.name,
-                m.order
             );
         }
+    }
+}
+
+/// The implicit steppers on a nonlinear problem, where a Rosenbrock method's order is its
+/// own and not its stability function's: Rodas5P's 5 (6 on the linear problems above).
+#[test]
+fn implicit_steppers_keep_their_order_on_a_nonlinear_problem() {
+    for m in methods().into_iter().filter(|m| m.implicit) {
+        let case = Case::of(Logistic);
+        assert!(!case.linear);
+        let err_at = |n: usize| {
+            let ctl = StepControl {
+                rtol: 1.0,
+                atol: [1.0; 2],
+                h_min: 0.0,
+                max_attempts: u64::MAX,
+                fixed_step: Some(case.t_end / n as f64),
+            };
+            error((m.make)(ctl).run(case.problem.as_ref()), case.exact)
+        };
+        let (e1, e2) = (err_at(m.steps), err_at(2 * m.steps));
+        let order = (e1 / e2).log2();
+        println!("{} on {}: observed order {order:.2}", m.name, case.name);
+        assert!(
+            (order - m.order).abs() < 0.1 * m.order,
+            "{} on {}: observed order {order:.2}, expected {} ({e1:e} -> {e2:e})",
+            m.name,
+            case.name,
+            m.order
+        );
     }
 }
 
@@ -562,4 +663,5 @@ fn every_stepper_asks_for_the_tolerances_at_each_steps_start_and_uses_them() {
     run("DOP853", Dop853::new);
     run("ROS34PW2", Ros34pw2::new);
     run("RODAS4", Rodas4::new);
+    run("Rodas5P", Rodas5p::new);
 }

@@ -11,8 +11,8 @@ use whirlmap_core::{simulate_observed, DropOptions, FrictionLaw, Method, Scene};
 /// Checks the translational rows at every 10th accepted step; counts the checks per mode.
 struct Check {
     quasi_static: bool,
-    /// Whether the drop runs RODAS4, whose matrix holds every term (the accumulators' rows,
-    /// the sticking constraint).
+    /// Whether the drop runs a Rosenbrock method (RODAS4, Rodas5P), whose matrix holds every
+    /// term (the accumulators' rows, the sticking constraint).
     exact: bool,
     /// The rotor's and the race's contact radii (m).
     radii: (f64, f64),
@@ -172,7 +172,7 @@ fn check(scene: Scene) -> Check {
 fn check_for(scene: Scene, duration_s: f64) -> Check {
     let mut c = Check {
         quasi_static: scene.quasi_static_race,
-        exact: scene.solver.method == Method::Rodas4,
+        exact: scene.solver.method.needs_exact_jacobian(),
         radii: (scene.rotor_radius_m(), scene.race_bore_radius_m()),
         every: 10,
         seen: 0,
@@ -276,26 +276,31 @@ fn drop_with(method: whirlmap_core::Method, rtol: f64, gap: bool) -> whirlmap_co
     whirlmap_core::simulate(&s, &opts).unwrap()
 }
 
-/// The implicit stepper with the free-flight gap bound against DOPRI5 at rtol 1e-9 on the
+/// The implicit steppers with the free-flight gap bound against DOPRI5 at rtol 1e-9 on the
 /// bouncing phase (13 impacts, free flights, friction switches): same impacts and class,
 /// forces converging as the tolerance tightens, and an energy audit that closes.
 #[test]
-fn implicit_stepper_converges_to_the_reference_on_a_bouncing_drop() {
-    use whirlmap_core::Method;
+fn implicit_steppers_converge_to_the_reference_on_a_bouncing_drop() {
     let reference = drop_with(Method::Dopri5, 1e-9, false);
+    for method in [Method::Ros34pw2, Method::Rodas4, Method::Rodas5p] {
+        converges_to(&reference, method);
+    }
+}
+
+fn converges_to(reference: &whirlmap_core::DropReport, method: Method) {
     let rf = &reference.features;
     let mut last_err = f64::INFINITY;
     for rtol in [1e-4, 1e-6, 1e-8] {
-        let r = drop_with(Method::Ros34pw2, rtol, true);
+        let r = drop_with(method, rtol, true);
         let f = &r.features;
         let err = ((f.first_contact_force_n - rf.first_contact_force_n).abs()
             / rf.first_contact_force_n)
             .max((f.max_contact_force_n - rf.max_contact_force_n).abs() / rf.max_contact_force_n);
         eprintln!(
-            "rtol {rtol:e}: force error {err:e}, {:?}, residual {:e}",
+            "{method:?} rtol {rtol:e}: force error {err:e}, {:?}, residual {:e}",
             r.stats, r.energy.residual_rel
         );
-        assert_eq!(f.impacts, rf.impacts, "rtol {rtol:e}");
+        assert_eq!(f.impacts, rf.impacts, "{method:?} rtol {rtol:e}");
         assert!(
             (f.first_contact_time_s - rf.first_contact_time_s).abs()
                 < 1e-6 * rf.first_contact_time_s,
@@ -303,7 +308,7 @@ fn implicit_stepper_converges_to_the_reference_on_a_bouncing_drop() {
             f.first_contact_time_s,
             rf.first_contact_time_s
         );
-        assert!(err < 1e-3, "rtol {rtol:e}: force error {err:e}");
+        assert!(err < 1e-3, "{method:?} rtol {rtol:e}: force error {err:e}");
         assert!(
             r.energy.residual_rel < 1e-5,
             "rtol {rtol:e}: {:?}",
@@ -311,9 +316,12 @@ fn implicit_stepper_converges_to_the_reference_on_a_bouncing_drop() {
         );
         assert!(
             err < last_err || err < 1e-8,
-            "no convergence: {err:e} after {last_err:e}"
+            "{method:?}: no convergence: {err:e} after {last_err:e}"
         );
         last_err = err;
     }
-    assert!(last_err < 1e-6, "rtol 1e-8: force error {last_err:e}");
+    assert!(
+        last_err < 1e-6,
+        "{method:?} rtol 1e-8: force error {last_err:e}"
+    );
 }

@@ -118,7 +118,7 @@ impl DropSystem {
                 c0_n: scene.static_load_rating_n,
             }),
             omega_eps: scene.drag_zero_speed_rad_s,
-            exact_jacobian: scene.solver.method == crate::scene::Method::Rodas4,
+            exact_jacobian: scene.solver.method.needs_exact_jacobian(),
             free_max_step: scene.solver.free_flight_max_step_s,
             free_gap_bound: scene.solver.free_flight_gap_bound,
             f_ref: (m_r * g).max(1e-3),
