@@ -665,3 +665,54 @@ fn every_stepper_asks_for_the_tolerances_at_each_steps_start_and_uses_them() {
     run("RODAS4", Rodas4::new);
     run("Rodas5P", Rodas5p::new);
 }
+
+/// The largest error of a step's interpolant at its midpoint, over a run of [`Logistic`].
+struct Midpoints(f64);
+impl whirlmap_core::ode::Observer<Logistic, 2> for Midpoints {
+    type Halt = std::convert::Infallible;
+    fn on_step(
+        &mut self,
+        _sys: &Logistic,
+        step: &whirlmap_core::ode::StepView<'_, 2>,
+    ) -> std::ops::ControlFlow<Self::Halt> {
+        let t = 0.5 * (step.dense.t0() + step.dense.t1());
+        self.0 = self.0.max(error(step.dense.eval(t), Logistic.exact(t)));
+        std::ops::ControlFlow::Continue(())
+    }
+}
+
+/// The implicit steppers' interpolants between the steps' ends, on fixed steps: RODAS4's
+/// cubic Hermite one is of order 3 (midpoint errors O(h^4)), so its midpoints converge at
+/// order 4 with its solution; Rodas5P's own is of order 4 (O(h^5)), so its midpoints keep
+/// the method's order 5, which the Hermite interpolant would cut to 4.
+#[test]
+fn the_implicit_steppers_interpolants_keep_their_order() {
+    fn order<M: Stepper<2>>(make: impl Fn(StepControl<2>) -> M, n: usize) -> f64 {
+        let err_at = |n: usize| {
+            let ctl = StepControl {
+                rtol: 1.0,
+                atol: [1.0; 2],
+                h_min: 0.0,
+                max_attempts: u64::MAX,
+                fixed_step: Some(Logistic.t_end() / n as f64),
+            };
+            let (mut t, mut y) = (0.0, Logistic.y0());
+            let mut mid = Midpoints(0.0);
+            integrate(
+                &Logistic,
+                &mut make(ctl),
+                &mut t,
+                &mut y,
+                Logistic.t_end(),
+                &mut mid,
+            )
+            .unwrap();
+            mid.0
+        };
+        (err_at(n) / err_at(2 * n)).log2()
+    }
+    let (rodas4, rodas5p) = (order(Rodas4::new, 40), order(Rodas5p::new, 20));
+    println!("midpoint orders: RODAS4 {rodas4:.2}, Rodas5P {rodas5p:.2}");
+    assert!((rodas4 - 4.0).abs() < 0.4, "RODAS4: {rodas4:.2}");
+    assert!((rodas5p - 5.0).abs() < 0.5, "Rodas5P: {rodas5p:.2}");
+}

@@ -207,6 +207,7 @@ impl<const N: usize> Stepper<N> for Rodas4<N> {
             gamma: GAMMA,
             attempt: Self::attempt::<S>,
             quadratures: true,
+            own_dense: false,
         };
         rosenbrock_step(
             &mut self.core,

@@ -7,8 +7,10 @@
 //! `(I - h gamma J) u_i = h gamma f(Y_i) + gamma sum_j c_ij u_j`, `Y_i = y0 + sum_j a_ij u_j`
 //! for stages 2-6 (stage 6 at `t + h`), then `Y_7 = Y_6 + u_6`, `Y_8 = Y_7 + u_7` (the
 //! embedded solution) and `y1 = Y_8 + u_8`, so `u_8` is the error estimate. Autonomous
-//! system: the `f_t` terms are left out. Dense output is the shared cubic Hermite
-//! interpolant of the step's ends.
+//! system: the `f_t` terms are left out. Dense output is the method's own of order 4,
+//! `y(th) = (1 - th) y0 + th (y1 + (1 - th) (K1 + th (K2 + th K3)))` with `K_r = sum_j h_rj u_j`
+//! (the `H` rows below): the events and the force peaks are located on it, and the cubic
+//! Hermite interpolant of the step's ends (order 3) would lose to it on steps this long.
 
 use super::control::{StepCore, StepLaw};
 use super::rosw::{rosenbrock_step, Lu, Rosenbrock};
@@ -122,6 +124,40 @@ const CC: [[f64; 7]; 8] = [
     ],
 ];
 
+/// The dense-output rows `h_rj` (`K_r = sum_j h_rj u_j`).
+const H: [[f64; 8]; 3] = [
+    [
+        25.948_786_856_663_858,
+        -2.557_972_484_584_623_5,
+        10.433_815_404_888_879,
+        -2.367_925_102_268_520_4,
+        0.524_948_541_321_073,
+        1.124_108_831_045_040_4,
+        0.427_287_619_443_187_4,
+        -0.172_022_210_701_554_93,
+    ],
+    [
+        -9.915_688_506_951_71,
+        -0.968_994_459_411_515_4,
+        3.043_803_724_297_845_3,
+        -24.495_224_566_215_796,
+        20.176_138_334_709_044,
+        15.980_663_614_246_51,
+        -6.789_040_303_419_874,
+        -6.710_236_069_923_372,
+    ],
+    [
+        11.419_903_575_922_262,
+        2.887_964_514_613_699_4,
+        72.921_379_959_960_29,
+        80.125_118_346_226_43,
+        -52.072_871_366_152_654,
+        -59.789_936_252_667_29,
+        -0.155_826_842_827_519_13,
+        4.883_087_185_713_722,
+    ],
+];
+
 /// The Rodas5P stepper: the derivative at the step start, the factored iteration matrix,
 /// controller memory and work counters.
 #[derive(Debug, Clone)]
@@ -218,6 +254,10 @@ impl<const N: usize> Rodas5p<N> {
         }
         stage!(7, 7);
         core.stats.rhs_evals += 7;
+        // The interpolant's K1..K3 into the dense rows 5-7 ([`Rosenbrock::own_dense`]).
+        for (row, h_r) in core.dense.r[5..8].iter_mut().zip(&H) {
+            *row = comb::<N, 8>(h_r, &u);
+        }
         let mut y1 = [0.0; N];
         let mut err = 0.0;
         let atol = core.step_atol;
@@ -248,6 +288,7 @@ impl<const N: usize> Stepper<N> for Rodas5p<N> {
             gamma: GAMMA,
             attempt: Self::attempt::<S>,
             quadratures: true,
+            own_dense: true,
         };
         rosenbrock_step(
             &mut self.core,

@@ -428,12 +428,17 @@ pub(super) struct Rosenbrock<'a, A> {
     /// ([`StiffJacobian::quad`]). A Rosenbrock method needs them for its order on the
     /// accumulators; a W-method does not, and leaves them out.
     pub(super) quadratures: bool,
+    /// Whether the attempt leaves its own dense-output coefficients `K1, K2, K3` in rows 5-7
+    /// of `core.dense.r`, for `y(th) = (1 - th) y0 + th (y1 + (1 - th) (K1 + th (K2 + th K3)))`
+    /// (Rodas5P's 4th-order interpolant); otherwise the step's ends give the cubic Hermite one.
+    pub(super) own_dense: bool,
 }
 
 /// One accepted step of a Rosenbrock method on the stiff Jacobian (ROS34PW2, RODAS4): the
 /// Jacobian once per step, a factorisation per attempt, the step control, then the cubic
 /// Hermite dense output in DOPRI5's nested form with the 4th coefficient zero, written in
-/// place (row 4 stays zero from `StepCore::new`, rows 5-7 unused with `terms` 5). `f0` is
+/// place (row 4 stays zero from `StepCore::new`, rows 5-7 unused with `terms` 5), or the
+/// method's own interpolant ([`Rosenbrock::own_dense`]). `f0` is
 /// the derivative at the step's start, and becomes the one at its end.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn rosenbrock_step<'c, const N: usize, S, A>(
@@ -472,13 +477,26 @@ where
     core.stats.rhs_evals += 1;
     let d = &mut core.dense;
     let r = &mut d.r;
-    for i in 0..N {
-        let ydiff = y1[i] - y[i];
-        let bspl = h * start[i] - ydiff;
-        r[0][i] = y[i];
-        r[1][i] = ydiff;
-        r[2][i] = bspl;
-        r[3][i] = ydiff - h * f1[i] - bspl;
+    if method.own_dense {
+        // In the nested form: r2 = K1, r3 = K2 + K3, r4 = -K3 (rows 5-7 hold K1..K3, from the
+        // accepted attempt, the last one).
+        for i in 0..N {
+            let (k1, k2, k3) = (r[5][i], r[6][i], r[7][i]);
+            r[0][i] = y[i];
+            r[1][i] = y1[i] - y[i];
+            r[2][i] = k1;
+            r[3][i] = k2 + k3;
+            r[4][i] = -k3;
+        }
+    } else {
+        for i in 0..N {
+            let ydiff = y1[i] - y[i];
+            let bspl = h * start[i] - ydiff;
+            r[0][i] = y[i];
+            r[1][i] = ydiff;
+            r[2][i] = bspl;
+            r[3][i] = ydiff - h * f1[i] - bspl;
+        }
     }
     (d.t0, d.h, d.t_end, d.terms, d.y1) = (t, h, t + h, 5, y1);
     *f0 = f1;
@@ -506,6 +524,7 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
             // Measured with them on 2026-11-24: the draft drops took 0.1-0.5 % more RHS
             // evaluations, so the W-method keeps its matrix without them.
             quadratures: false,
+            own_dense: false,
         };
         rosenbrock_step(
             &mut self.core,
