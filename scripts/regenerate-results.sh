@@ -49,7 +49,7 @@ for part in "${parts[@]}"; do
       done ;;
     accuracy)
       for s in accuracy:accuracy-cases accuracy-radial:accuracy-radial accuracy-implicit:accuracy-implicit \
-               accuracy-rodas4:accuracy-rodas4; do
+               accuracy-rodas4:accuracy-rodas4 accuracy-rodas5p:accuracy-rodas5p; do
         out=${s%%:*}; cases=${s##*:}
         rm -rf "results/$out"
         "$W" accuracy --cases "sweeps/$cases.json" --out "results/$out"
