@@ -553,3 +553,112 @@ fn a_resumed_sweep_keeps_the_finished_critical_search_and_orbits() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+const CRITICAL_SPEC: &str = r#"{"name": "crit", "duration_s": 0.1,
+    "scene": {"solver": {"rtol": 1e-7}},
+    "axes": {"speed_rpm": [4000], "mu": [0.3]},
+    "critical": {"mu": [0.3, 0.4], "speed_rpm": {"from": 2000, "to": 8000},
+      "resolution_rpm": 1000, "tol_rpm": 250}}"#;
+
+/// A sweep killed in the middle of its critical search keeps the search's classified drops
+/// (`critical-drops.jsonl`): `--resume` runs only the others and writes the `critical.json`
+/// of an uninterrupted run, then removes the log.
+#[test]
+fn a_sweep_killed_in_its_critical_search_resumes_without_rerunning_its_drops() {
+    let dir = temp_dir("resume-critical");
+    let spec = spec_file(&dir, "crit", CRITICAL_SPEC);
+    let (full, killed) = (dir.join("full"), dir.join("killed"));
+    let o = whirlmap(&["sweep", s(&spec), "--out", s(&full), "--no-progress"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        !full.join("critical-drops.jsonl").exists(),
+        "the log is removed once critical.json is written"
+    );
+    let args = [
+        "sweep",
+        s(&spec),
+        "--out",
+        s(&killed),
+        "--threads",
+        "2",
+        "--no-progress",
+    ];
+    let log = killed.join("critical-drops.jsonl");
+    let logged = kill_after_lines(&args, &log, 5);
+    assert!(!killed.join("critical.json").exists(), "killed mid-search");
+    let o = whirlmap(&[
+        "sweep",
+        s(&spec),
+        "--out",
+        s(&killed),
+        "--resume",
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let err = stderr(&o);
+    let reused: usize = err
+        .split("critical search: ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no reuse reported: {err}"));
+    assert!(reused >= logged, "{reused} reused of {logged} logged");
+    assert_eq!(
+        std::fs::read(killed.join("critical.json")).unwrap(),
+        std::fs::read(full.join("critical.json")).unwrap()
+    );
+    assert!(!log.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// What a resumed critical search takes from the log, shown by a staged log: a line of the
+/// same coefficient, speed and scene is used (here a false class at the top scan speed, which
+/// moves the onset), a line of another scene is not, and a torn last line is cut.
+#[test]
+fn a_resumed_critical_search_uses_exactly_the_logged_drops_of_its_scenes() {
+    let dir = temp_dir("critical-log");
+    let spec = spec_file(&dir, "crit", CRITICAL_SPEC);
+    let out = dir.join("out");
+    let run = |resume: bool| {
+        let mut a = vec!["sweep", s(&spec), "--out", s(&out), "--no-progress"];
+        if resume {
+            a.push("--resume");
+        }
+        let o = whirlmap(&a);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        o
+    };
+    run(false);
+    let full = read_json(&out.join("critical.json"));
+    let row = |v: &serde_json::Value, j: usize| v[j].clone();
+    let hash = |j: usize| full[j]["scene_hash"].as_str().unwrap().to_string();
+    // At the top of the scan mu 0.4 whirls and mu 0.3 does not; the log says the opposite.
+    let top = |j: usize| full[j]["scan"].as_array().unwrap().last().unwrap()["class"].clone();
+    assert_eq!(
+        (top(0), top(1)),
+        ("pendulum".into(), "backward_whirl".into())
+    );
+    let log = format!(
+        "{}\n{}\n{}",
+        serde_json::json!({"mu": 0.4, "speed_rpm": 8000.0, "scene_hash": hash(1), "class": "pendulum"}),
+        serde_json::json!({"mu": 0.3, "speed_rpm": 8000.0, "scene_hash": "0000000000000000", "class": "backward_whirl"}),
+        r#"{"mu": 0.3, "speed_rpm": 7000.0, "scene_hash": "#,
+    );
+    std::fs::remove_file(out.join("critical.json")).unwrap();
+    std::fs::write(out.join("critical-drops.jsonl"), log).unwrap();
+    let o = run(true);
+    assert!(
+        stderr(&o).contains("critical search: 1 drops reused"),
+        "{}",
+        stderr(&o)
+    );
+    let resumed = read_json(&out.join("critical.json"));
+    assert_eq!(
+        row(&resumed, 0),
+        row(&full, 0),
+        "the other scene's line is not used"
+    );
+    assert_ne!(row(&resumed, 1), row(&full, 1), "the logged class is used");
+    assert!(!out.join("critical-drops.jsonl").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -20,6 +20,9 @@ pub const MANIFEST_FILE: &str = "manifest.json";
 pub const CRITICAL_FILE: &str = "critical.json";
 /// The same rows as a table (one line per friction coefficient).
 pub const CRITICAL_CSV_FILE: &str = "critical.csv";
+/// The critical search's classified drops while it runs, one JSON line each (a resumed run
+/// reuses them); removed once [`CRITICAL_FILE`] is written.
+pub const CRITICAL_DROPS_FILE: &str = "critical-drops.jsonl";
 /// Folder of the recorded orbits of Fig. 3 ([`orbit_file`], [`orbit_error_file`]).
 pub const ORBITS_DIR: &str = "orbits";
 /// Folder of the charts.

@@ -617,6 +617,19 @@ pub fn critical_rows_ticked(
     o: &CriticalOptions,
     ticker: &Ticker,
 ) -> Result<Vec<CriticalRow>, InvalidParameter> {
+    critical_rows_logged(base, mus, o, ticker, None)
+}
+
+/// [`critical_rows_ticked`], answering the drops `log` knows from an earlier run and logging
+/// every other classified drop to it ([`crate::critical_log`]). The rows are those of a
+/// search without a log: each is a function of its drops' classes.
+pub fn critical_rows_logged(
+    base: &Scene,
+    mus: &[f64],
+    o: &CriticalOptions,
+    ticker: &Ticker,
+    log: Option<&crate::critical_log::DropLog>,
+) -> Result<Vec<CriticalRow>, InvalidParameter> {
     check_mus(mus)?;
     o.validate()?;
     ticker.expect_more(mus.len() * o.scan_speeds().len());
@@ -635,9 +648,20 @@ pub fn critical_rows_ticked(
     for s in &scenes {
         s.validate()?;
     }
+    let hashes: Vec<String> = scenes.iter().map(Scene::hash_hex).collect();
     let results = search_all(
         |j, speed| {
-            let outcome = drop_outcome(&scenes[j], speed, &drop_opts);
+            let (mu, hash) = (mus[j], &hashes[j]);
+            let outcome = match log.and_then(|l| l.known(mu, speed, hash)) {
+                Some(class) => Outcome::Class(class),
+                None => {
+                    let outcome = drop_outcome(&scenes[j], speed, &drop_opts);
+                    if let (Some(l), Outcome::Class(class)) = (log, &outcome) {
+                        l.record(mu, speed, hash, *class);
+                    }
+                    outcome
+                }
+            };
             ticker.tick();
             outcome
         },
@@ -646,8 +670,8 @@ pub fn critical_rows_ticked(
     )?;
     Ok(results
         .into_iter()
-        .zip(mus.iter().zip(&scenes))
-        .map(|(r, (&mu, s))| r.into_row(mu, o, s.hash_hex()))
+        .zip(mus.iter().zip(hashes))
+        .map(|(r, (&mu, hash))| r.into_row(mu, o, hash))
         .collect())
 }
 

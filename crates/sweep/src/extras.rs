@@ -1,7 +1,8 @@
 //! What a sweep spec asks for beside its grid: the critical-speed search (`critical.json`)
 //! and the orbits of the Fig. 3 chart (`orbits/*.json`), in the forms the charts (`whirlmap-plot`) read.
 
-use crate::critical::{critical_rows_ticked, csv_text, CriticalRow};
+use crate::critical::{critical_rows_logged, csv_text, CriticalRow};
+use crate::critical_log::DropLog;
 use crate::progress::Ticker;
 use crate::run::run_drop;
 use crate::spec::SweepSpec;
@@ -84,8 +85,9 @@ pub fn run_all(
 /// ensemble when `owns(0)` (it is one job). When more than one fails, the error reported is
 /// the critical search's, then the orbits', then the ensemble's. With `resume` (a sweep's
 /// `--resume` of the same spec and build), what the killed run finished is kept: a
-/// `critical.json` with a decided row for every friction coefficient the run owns, each orbit
-/// file, and the ensemble's members ([`crate::ensemble::run_ensemble`]); the rest runs.
+/// `critical.json` with a decided row for every friction coefficient the run owns (or else the
+/// critical search's logged drops, [`crate::critical_log`]), each orbit file, and the
+/// ensemble's members ([`crate::ensemble::run_ensemble`]); the rest runs.
 pub fn run_all_owned(
     spec: &SweepSpec,
     out_dir: &Path,
@@ -163,7 +165,9 @@ fn run_probability_here(
     Ok(Some(dir))
 }
 
-pub use whirlmap_results::files::{CRITICAL_CSV_FILE, CRITICAL_FILE, PROBABILITY_DIR};
+pub use whirlmap_results::files::{
+    CRITICAL_CSV_FILE, CRITICAL_DROPS_FILE, CRITICAL_FILE, PROBABILITY_DIR,
+};
 
 /// Runs the spec's `critical` section, if any, and writes `critical.json` (a list of
 /// [`CriticalRow`] in the order of `critical.mu`) and `critical.csv`. Returns the JSON file.
@@ -182,7 +186,9 @@ pub fn run_critical_owned(
 }
 
 /// [`run_critical_owned`], counting its drops on `ticker`. With `resume`, a `critical.json`
-/// already in `out_dir` ([`kept_critical`]) is kept and nothing runs.
+/// already in `out_dir` ([`kept_critical`]) is kept and nothing runs; without one, the drops
+/// the killed run logged ([`crate::critical_log`]) are not run again. The log is removed once
+/// `critical.json` is written.
 fn run_critical_ticked(
     spec: &SweepSpec,
     out_dir: &Path,
@@ -203,16 +209,34 @@ fn run_critical_ticked(
     let rows = if mus.is_empty() {
         Vec::new()
     } else {
+        let log = DropLog::open(out_dir, resume)?;
         // The spec was validated before anything ran, so this cannot fail.
-        critical_rows_ticked(
+        let rows = critical_rows_logged(
             &spec.base_scene(),
             &mus,
             &c.options(spec.duration_s),
             ticker,
+            Some(&log),
         )
-        .expect("the spec's critical section was validated")
+        .expect("the spec's critical section was validated");
+        if log.reused() > 0 {
+            eprintln!(
+                "sweep {}: critical search: {} drops reused from the killed run's {}",
+                spec.name,
+                log.reused(),
+                CRITICAL_DROPS_FILE
+            );
+        }
+        log.finish()?;
+        rows
     };
-    write_critical(out_dir, &rows)
+    let written = write_critical(out_dir, &rows)?;
+    // The log served its purpose: `critical.json` holds the search now.
+    let log = out_dir.join(CRITICAL_DROPS_FILE);
+    if log.exists() {
+        std::fs::remove_file(&log).map_err(|source| ExtrasError::Io { path: log, source })?;
+    }
+    Ok(written)
 }
 
 /// The rows of the `critical.json` a killed run of the same spec and build left in `out_dir`,

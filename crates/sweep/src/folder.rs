@@ -11,8 +11,9 @@
 //! ## What a run owns
 //! Every name in [`OWNED`] is whirlmap's. A new run into a folder that holds any of them is
 //! refused (exit 2) unless it is told `--resume` (the same spec and build: the records are
-//! kept, and so are what the extras finished: `critical.json`, the orbit files and the
-//! probability ensemble's members, [`crate::extras::run_all_owned`]; every other derived
+//! kept, and so are what the extras finished: `critical.json`, the critical search's logged
+//! drops ([`crate::critical_log`]), the orbit files and the probability ensemble's members,
+//! [`crate::extras::run_all_owned`]; every other derived
 //! file is removed and made again) or `--overwrite` (the old files are
 //! moved into [`PREVIOUS_DIR`] and deleted once the new run's first records are synced to
 //! disk, so a rerun killed early loses nothing). Other files are left alone and never read.
@@ -39,8 +40,8 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use whirlmap_results::files::{
     BEARING_REPORT_FILE, CHARTS_DIR, COMPARE_CLASSES_FILE, COMPARE_REPORT_FILE, CONTOURS_FILE,
-    CRITICAL_CSV_FILE, CRITICAL_FILE, MANIFEST_FILE, ORBITS_DIR, POINTS_FILE, PROBABILITY_DIR,
-    SHARD_FILE, SUMMARY_FILE, TIMINGS_FILE,
+    CRITICAL_CSV_FILE, CRITICAL_DROPS_FILE, CRITICAL_FILE, MANIFEST_FILE, ORBITS_DIR, POINTS_FILE,
+    PROBABILITY_DIR, SHARD_FILE, SUMMARY_FILE, TIMINGS_FILE,
 };
 use whirlmap_results::manifest::{Manifest, ShardTag};
 
@@ -55,6 +56,7 @@ pub const OWNED: &[&str] = &[
     MANIFEST_FILE,
     CRITICAL_FILE,
     CRITICAL_CSV_FILE,
+    CRITICAL_DROPS_FILE,
     ORBITS_DIR,
     CHARTS_DIR,
     PROBABILITY_DIR,

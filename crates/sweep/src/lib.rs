@@ -31,6 +31,7 @@ pub mod build_info;
 pub mod classify;
 pub mod compare;
 pub mod critical;
+pub mod critical_log;
 pub mod ensemble;
 pub mod extras;
 pub mod extremes;
