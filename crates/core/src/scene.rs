@@ -109,7 +109,7 @@ pub struct SolverSettings {
     /// fidelity's); `dopri5`, the explicit Dormand-Prince 5(4) pair (the `reference`
     /// fidelity's); `ros34pw2`, the 3rd-order Rosenbrock-W method (the `draft` fidelity's);
     /// `dop853` the independent reference of `whirlmap accuracy`; `rodas5p`, the 5th-order
-    /// Rosenbrock method on RODAS4's Jacobian, for tolerances of 1e-6 and tighter.
+    /// Rosenbrock method on RODAS4's Jacobian, for errors below about 1e-5 (docs/accuracy.md).
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a

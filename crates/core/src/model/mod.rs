@@ -58,7 +58,7 @@ pub struct DropSystem {
     drag: Option<drag::Palmgren>,
     omega_eps: f64,
     /// Whether the stiff Jacobian holds the terms a Rosenbrock method needs for its order
-    /// (RODAS4): the accumulators' rows and the sticking constraint's slopes. A W-method
+    /// (RODAS4, Rodas5P): the accumulators' rows and the sticking constraint's slopes. A W-method
     /// (ROS34PW2) keeps its order without them and is handed the cheaper matrix.
     exact_jacobian: bool,
     free_max_step: f64,

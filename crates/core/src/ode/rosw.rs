@@ -415,7 +415,8 @@ impl<const N: usize> Ros34pw2<N> {
 }
 
 /// What differs between the Rosenbrock methods sharing [`rosenbrock_step`]: the step law, the
-/// diagonal `gamma` of the matrix `I - h gamma J`, and the attempt.
+/// diagonal `gamma` of the matrix `I - h gamma J`, the attempt, whether the matrix holds the
+/// quadrature rows, and the interpolant.
 pub(super) struct Rosenbrock<'a, A> {
     /// The step-size law (orders, safety, growth limits).
     pub(super) law: &'a StepLaw,
@@ -434,7 +435,7 @@ pub(super) struct Rosenbrock<'a, A> {
     pub(super) own_dense: bool,
 }
 
-/// One accepted step of a Rosenbrock method on the stiff Jacobian (ROS34PW2, RODAS4): the
+/// One accepted step of a Rosenbrock method on the stiff Jacobian (ROS34PW2, RODAS4, Rodas5P): the
 /// Jacobian once per step, a factorisation per attempt, the step control, then the cubic
 /// Hermite dense output in DOPRI5's nested form with the 4th coefficient zero, written in
 /// place (row 4 stays zero from `StepCore::new`, rows 5-7 unused with `terms` 5), or the

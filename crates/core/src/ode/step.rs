@@ -37,7 +37,9 @@ pub struct StepControl<const N: usize> {
 }
 
 /// The continuous extension of one accepted step, valid on `[t0, t_end]`: DOPRI5's
-/// 4th-order one (5 coefficient vectors) or DOP853's 7th-order one (8).
+/// 4th-order one (5 coefficient vectors), DOP853's 7th-order one (8), or a Rosenbrock
+/// method's (5: the cubic Hermite one, or Rodas5P's own of order 4, whose attempts leave their
+/// coefficients in rows 5-7 as scratch, unread with 5 terms).
 ///
 /// Both share Hairer's nested form `r0 + th (r1 + th1 (r2 + th (r3 + th1 (r4 + ...))))`
 /// with `th = (t - t0)/h`, `th1 = 1 - th`, so one type serves both steppers.
@@ -46,7 +48,7 @@ pub struct Dense<const N: usize> {
     pub(super) t0: f64,
     pub(super) h: f64,
     pub(super) t_end: f64,
-    /// Number of coefficient vectors in use: 5 (DOPRI5) or 8 (DOP853).
+    /// Number of coefficient vectors in use: 5 (DOPRI5, the Rosenbrock methods) or 8 (DOP853).
     pub(super) terms: usize,
     pub(super) r: [[f64; N]; 8],
     /// The step's end state, kept exactly (not re-summed from `r`).
