@@ -6,7 +6,8 @@
 #   scripts/regenerate-results.sh [PART...]
 #
 # PART is one of: paper radial reference physics nightly ensemble adaptive accuracy drops
-# thermal life (default: all). About 40 minutes on two cores in all; `paper` alone about one.
+# thermal life (default: all), or accuracy-charts (the accuracy studies' charts drawn again
+# from their study.json, no drops run). About 40 minutes on two cores in all; `paper` alone about one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --quiet
@@ -53,6 +54,12 @@ for part in "${parts[@]}"; do
         out=${s%%:*}; cases=${s##*:}
         rm -rf "results/$out"
         "$W" accuracy --cases "sweeps/$cases.json" --out "results/$out"
+      done ;;
+    accuracy-charts)
+      for s in accuracy:accuracy-cases accuracy-radial:accuracy-radial accuracy-implicit:accuracy-implicit \
+               accuracy-rodas4:accuracy-rodas4 accuracy-rodas5p:accuracy-rodas5p; do
+        out=${s%%:*}; cases=${s##*:}
+        "$W" accuracy --cases "sweeps/$cases.json" --out "results/$out" --charts-only
       done ;;
     drops)
       # Fig. 3(f): mu 0.3 at 8000 r/min as released, and with a 2 um unbalance.

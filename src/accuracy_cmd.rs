@@ -26,6 +26,10 @@ pub struct AccuracyArgs {
     /// Worker threads (1 gives the cleanest wall times); default 1.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
     threads: u32,
+    /// Run no drops: draw the charts again from the `study.json` already in --out (the study
+    /// of --cases), replacing only the charts.
+    #[arg(long, conflicts_with = "overwrite")]
+    charts_only: bool,
 }
 
 /// Runs the study and writes `accuracy.csv`, `accuracy.md`, `study.json` and the charts.
@@ -33,6 +37,16 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
     // The error's text already carries its cause: `coded` keeps it from being printed twice
     // (as the error and again as its source).
     let spec = AccuracySpec::load(&a.cases).map_err(|e| Failure::coded(2, e))?;
+    if a.charts_only {
+        let study = read_study(&a.out, &spec)?;
+        draw_charts(&a.out, &spec.name, &study)?;
+        errln!(
+            "charts drawn again from {} into {}",
+            a.out.join(STUDY_FILE).display(),
+            a.out.display()
+        );
+        return Ok(());
+    }
     crate::refuse_existing_results(&a.out, a.overwrite).map_err(Failure::Input)?;
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create {}", a.out.display()))
@@ -66,23 +80,71 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
     let md = to_markdown(&study, &spec);
     write("accuracy.md", md.clone())?;
     write(
-        "study.json",
+        STUDY_FILE,
         serde_json::to_string_pretty(&study).expect("a study serialises"),
     )?;
-    let (cases, runs) = chart_runs(&study);
+    draw_charts(&a.out, &spec.name, &study)?;
+    outln!("{md}");
+    errln!("written to {}", a.out.display());
+    Ok(())
+}
+
+/// The study's own record, from which its charts can be drawn again.
+const STUDY_FILE: &str = "study.json";
+
+/// The `study.json` in `out`, checked to be a study of `spec`'s cases (exit 2 otherwise).
+fn read_study(out: &std::path::Path, spec: &AccuracySpec) -> Result<Study, Failure> {
+    let path = out.join(STUDY_FILE);
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| {
+            format!(
+                "--charts-only draws from {}, which cannot be read: run the study first",
+                path.display()
+            )
+        })
+        .map_err(Failure::Input)?;
+    let study: Study = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not a study's record", path.display()))
+        .map_err(Failure::Input)?;
+    // The cases in order, and the settings (the preset rows aside) in order of first row.
+    let cases: Vec<&str> = study.references.iter().map(|r| r.case.as_str()).collect();
+    let mut settings: Vec<&str> = Vec::new();
+    for r in &study.rows {
+        if !r.setting.starts_with("preset:") && !settings.contains(&r.setting.as_str()) {
+            settings.push(&r.setting);
+        }
+    }
+    let want_cases: Vec<&str> = spec.cases.iter().map(|c| c.name.as_str()).collect();
+    let want_settings: Vec<&str> = spec.settings.iter().map(|s| s.name.as_str()).collect();
+    if (&cases, &settings) != (&want_cases, &want_settings) {
+        return Err(Failure::Input(anyhow::anyhow!(
+            "{} holds a study of the cases [{}] and settings [{}], not the study of --cases {} \
+             (cases [{}], settings [{}])",
+            path.display(),
+            cases.join(", "),
+            settings.join(", "),
+            spec.name,
+            want_cases.join(", "),
+            want_settings.join(", ")
+        )));
+    }
+    Ok(study)
+}
+
+/// Draws `work_precision` and `work_precision_wall` (PNG and SVG) of `study` into `out`.
+fn draw_charts(out: &std::path::Path, name: &str, study: &Study) -> Result<(), Failure> {
+    let (cases, runs) = chart_runs(study);
     for (axis, stem) in [
         (CostAxis::RhsEvals, "work_precision"),
         (CostAxis::WallMs, "work_precision_wall"),
     ] {
         for ext in ["png", "svg"] {
-            let p = a.out.join(format!("{stem}.{ext}"));
-            let title = format!("Work-precision: {} (reference DOP853)", spec.name);
+            let p = out.join(format!("{stem}.{ext}"));
+            let title = format!("Work-precision: {name} (reference DOP853)");
             draw_work_precision(&p, &cases, &runs, axis, &title)
                 .map_err(|e| Failure::Output(e.into()))?;
         }
     }
-    outln!("{md}");
-    errln!("written to {}", a.out.display());
     Ok(())
 }
 

@@ -98,5 +98,49 @@ fn accuracy_writes_its_table_and_charts() {
     std::fs::write(&bad, r#"{"rtol": [0.5], "cases": [], "settings": []}"#).unwrap();
     let out = whirlmap(&["accuracy", "--cases", bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
+
+    // `--charts-only` draws the charts again from study.json alone: with the table and the
+    // charts gone, only the charts come back.
+    for f in [
+        "accuracy.csv",
+        "work_precision.png",
+        "work_precision_wall.svg",
+    ] {
+        std::fs::remove_file(out_dir.join(f)).unwrap();
+    }
+    let charts_only = |cases: &std::path::Path| {
+        whirlmap(&[
+            "accuracy",
+            "--cases",
+            cases.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--charts-only",
+        ])
+    };
+    let out = charts_only(&cases);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out_dir.join("work_precision.png").exists());
+    assert!(out_dir.join("work_precision_wall.svg").exists());
+    assert!(!out_dir.join("accuracy.csv").exists(), "no drop ran");
+    // Another study's cases file is refused, naming both.
+    let other = dir.join("other.json");
+    std::fs::write(
+        &other,
+        r#"{"name": "o", "rtol": [1e-4], "cases": [{"name": "whirl", "scene": {}}],
+            "settings": [{"name": "full"}]}"#,
+    )
+    .unwrap();
+    let out = charts_only(&other);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("[pendulum]") && err.contains("[whirl]"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -2,9 +2,9 @@
 //! case and one line per setting (its tolerance ladder), drawn with the embedded font.
 
 use crate::render::{
-    draw_legend_row, render, text_style, with_header, DrawResult, Figure, LegendMark, RenderError,
-    AXIS_COLOUR, AXIS_DESC_FONT, CAPTION_FONT, GRID_BOLD, GRID_LIGHT, TICK_FONT, TITLE_BAND,
-    TITLE_FONT,
+    draw_legend_row, legend_rows, render, text_style, with_header, DrawResult, Figure, LegendMark,
+    RenderError, AXIS_COLOUR, AXIS_DESC_FONT, CAPTION_FONT, GRID_BOLD, GRID_LIGHT, TICK_FONT,
+    TITLE_BAND, TITLE_FONT,
 };
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -169,6 +169,8 @@ impl WorkPrecision {
         let (yl, yh) = decades(yl, yh);
         let mut chart = ChartBuilder::on(&body)
             .margin(8)
+            // Room for the last decade's tick label, centred on the right edge.
+            .margin_right(24)
             .x_label_area_size(48)
             .y_label_area_size(70)
             .build_cartesian_2d((xl..xh).log_scale(), (yl..yh).log_scale())?;
@@ -215,15 +217,6 @@ impl WorkPrecision {
 impl Figure for WorkPrecision {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
         let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
-        let (h_total, _) = (body.dim_in_pixel().1, 0);
-        let (plots, legend) = body.split_vertically(h_total.saturating_sub(70));
-        let cols = 3usize;
-        let rows = self.panels.len().div_ceil(cols).max(1);
-        let areas = plots.split_evenly((rows, cols));
-        for (a, p) in areas.iter().zip(&self.panels) {
-            self.panel(a, p)?;
-        }
-        let (l1, l2) = legend.split_vertically(35);
         let entries: Vec<(LegendMark, &str)> = self
             .settings
             .iter()
@@ -237,9 +230,23 @@ impl Figure for WorkPrecision {
                 (mark, s.as_str())
             })
             .collect();
-        let half = entries.len().div_ceil(2);
-        draw_legend_row(&l1, &entries[..half])?;
-        draw_legend_row(&l2, &entries[half..])?;
+        // As many legend rows as the settings' names need, 35 px each, under the panels.
+        let legend_rows = legend_rows(&body, &entries)?;
+        let h_total = body.dim_in_pixel().1;
+        let (plots, legend) =
+            body.split_vertically(h_total.saturating_sub(35 * legend_rows.len() as u32));
+        let cols = 3usize;
+        let rows = self.panels.len().div_ceil(cols).max(1);
+        let areas = plots.split_evenly((rows, cols));
+        for (a, p) in areas.iter().zip(&self.panels) {
+            self.panel(a, p)?;
+        }
+        let mut rest = legend;
+        for row in legend_rows {
+            let (band, below) = rest.split_vertically(35);
+            draw_legend_row(&band, row)?;
+            rest = below;
+        }
         // A note on the markers, in the last free panel if any.
         if let Some(a) = areas.get(self.panels.len()) {
             let style = text_style(TICK_FONT);

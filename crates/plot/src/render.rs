@@ -363,14 +363,42 @@ pub(crate) enum LegendMark {
     Dot(RGBColor),
 }
 
+const MARK_W: i32 = 26;
+const MARK_GAP: i32 = 7;
+const ENTRY_GAP: i32 = 30;
+
+/// A run of legend entries.
+pub(crate) type LegendEntries<'e, 'l> = &'e [(LegendMark, &'l str)];
+
+/// The legend `entries` split into rows that each fit the width of `area` less 20 px on either
+/// side (an entry wider than that gets a row of its own), in order; at least one row.
+pub(crate) fn legend_rows<'e, 'l, DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &'e [(LegendMark, &'l str)],
+) -> Result<Vec<LegendEntries<'e, 'l>>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let style = text_style(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center));
+    // A margin of 20 px on either side.
+    let width = area.dim_in_pixel().0 as i32 - 40;
+    let mut rows = Vec::new();
+    let (mut start, mut used) = (0, 0);
+    for (i, (_, label)) in entries.iter().enumerate() {
+        let w = MARK_W + MARK_GAP + area.estimate_text_size(label, &style)?.0 as i32;
+        if i > start && used + ENTRY_GAP + w > width {
+            rows.push(&entries[start..i]);
+            (start, used) = (i, w);
+        } else {
+            used += if i > start { ENTRY_GAP + w } else { w };
+        }
+    }
+    rows.push(&entries[start..]);
+    Ok(rows)
+}
+
 /// Draws a one-row legend centred in `area` (outside the plot, so it never hides data).
 pub(crate) fn draw_legend_row<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[(LegendMark, &str)],
 ) -> DrawResult<DB> {
-    const MARK_W: i32 = 26;
-    const MARK_GAP: i32 = 7;
-    const ENTRY_GAP: i32 = 30;
     let style = text_style(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center));
     let mut widths = Vec::with_capacity(entries.len());
     for (_, label) in entries {
