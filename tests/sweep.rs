@@ -612,8 +612,9 @@ fn a_sweep_killed_in_its_critical_search_resumes_without_rerunning_its_drops() {
 }
 
 /// What a resumed critical search takes from the log, shown by a staged log: a line of the
-/// same coefficient, speed and scene is used (here a false class at the top scan speed, which
-/// moves the onset), a line of another scene is not, and a torn last line is cut.
+/// same coefficient, speed and scene is used (here a false class at the top scan speed), a
+/// line of another scene is not, nor a last line the kill cut before its newline (whole JSON
+/// here, so only its missing newline keeps it out), nor a line that is not UTF-8.
 #[test]
 fn a_resumed_critical_search_uses_exactly_the_logged_drops_of_its_scenes() {
     let dir = temp_dir("critical-log");
@@ -638,17 +639,20 @@ fn a_resumed_critical_search_uses_exactly_the_logged_drops_of_its_scenes() {
         (top(0), top(1)),
         ("pendulum".into(), "backward_whirl".into())
     );
-    let log = format!(
-        "{}\n{}\n{}",
+    let mut log = format!(
+        "{}\n{}\n",
         serde_json::json!({"mu": 0.4, "speed_rpm": 8000.0, "scene_hash": hash(1), "class": "pendulum"}),
         serde_json::json!({"mu": 0.3, "speed_rpm": 8000.0, "scene_hash": "0000000000000000", "class": "backward_whirl"}),
-        r#"{"mu": 0.3, "speed_rpm": 7000.0, "scene_hash": "#,
-    );
+    )
+    .into_bytes();
+    log.extend_from_slice(b"\xff\xfe not a line\n");
+    let torn = serde_json::json!({"mu": 0.3, "speed_rpm": 8000.0, "scene_hash": hash(0), "class": "backward_whirl"});
+    log.extend_from_slice(torn.to_string().as_bytes());
     std::fs::remove_file(out.join("critical.json")).unwrap();
     std::fs::write(out.join("critical-drops.jsonl"), log).unwrap();
     let o = run(true);
     assert!(
-        stderr(&o).contains("critical search: 1 drops reused"),
+        stderr(&o).contains("critical search: 1 drop reused"),
         "{}",
         stderr(&o)
     );
@@ -656,9 +660,14 @@ fn a_resumed_critical_search_uses_exactly_the_logged_drops_of_its_scenes() {
     assert_eq!(
         row(&resumed, 0),
         row(&full, 0),
-        "the other scene's line is not used"
+        "neither the other scene's line nor the torn one is used"
     );
     assert_ne!(row(&resumed, 1), row(&full, 1), "the logged class is used");
+    assert!(!out.join("critical-drops.jsonl").exists());
+
+    // A log a kill left beside a finished critical.json goes at the next resume.
+    std::fs::write(out.join("critical-drops.jsonl"), "").unwrap();
+    run(true);
     assert!(!out.join("critical-drops.jsonl").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }

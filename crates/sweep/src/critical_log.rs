@@ -17,6 +17,7 @@ use std::collections::HashMap;
 use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use whirlmap_core::OrbitClass;
 use whirlmap_results::files::CRITICAL_DROPS_FILE;
@@ -36,18 +37,19 @@ struct Line {
 pub struct DropLog {
     path: PathBuf,
     file: Mutex<File>,
-    /// (mu bits, speed bits) -> (scene hash, class), from the earlier run.
-    known: HashMap<(u64, u64), (String, OrbitClass)>,
+    /// (mu bits, speed bits, scene hash) -> class, from the earlier run.
+    known: HashMap<(u64, u64, String), OrbitClass>,
     /// Drops answered from `known`.
-    reused: Mutex<usize>,
+    reused: AtomicUsize,
     /// The first failed append: the search goes on, and [`DropLog::finish`] reports it.
     error: Mutex<Option<std::io::Error>>,
 }
 
 impl DropLog {
-    /// Opens the log in `out_dir`. With `resume`, the lines an earlier run left are read and
-    /// rewritten without the ones that cannot be read (a torn last line); otherwise an old log
-    /// is removed.
+    /// Opens the log in `out_dir`. With `resume`, the lines an earlier run left are read, and
+    /// the file is rewritten with only the lines that can be read (a torn last line, a line
+    /// that is not a drop's, are dropped); otherwise it starts empty. A log that exists but
+    /// cannot be read is an error (a missing one is an empty one).
     pub fn open(out_dir: &Path, resume: bool) -> Result<Self, ExtrasError> {
         let path = out_dir.join(CRITICAL_DROPS_FILE);
         let io = |source| ExtrasError::Io {
@@ -55,18 +57,24 @@ impl DropLog {
             source,
         };
         let mut known = HashMap::new();
-        let mut kept = String::new();
+        let mut kept = Vec::new();
         if resume {
-            if let Ok(text) = std::fs::read_to_string(&path) {
-                // Only whole lines: a line without its newline was cut by the kill.
-                for line in text.split_inclusive('\n').filter(|l| l.ends_with('\n')) {
-                    if let Ok(l) = serde_json::from_str::<Line>(line) {
-                        known.insert(
-                            (l.mu.to_bits(), l.speed_rpm.to_bits()),
-                            (l.scene_hash, l.class),
-                        );
-                        kept.push_str(line);
-                    }
+            let bytes = match std::fs::read(&path) {
+                Ok(b) => b,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+                Err(e) => return Err(io(e)),
+            };
+            // Only whole lines: a line without its newline was cut by the kill.
+            for line in bytes.split_inclusive(|b| *b == b'\n') {
+                if !line.ends_with(b"\n") {
+                    continue;
+                }
+                if let Ok(l) = serde_json::from_slice::<Line>(line) {
+                    known.insert(
+                        (l.mu.to_bits(), l.speed_rpm.to_bits(), l.scene_hash),
+                        l.class,
+                    );
+                    kept.extend_from_slice(line);
                 }
             }
         }
@@ -74,7 +82,7 @@ impl DropLog {
             path: out_dir.to_path_buf(),
             source,
         })?;
-        whirlmap_results::write_atomic(&path, kept.as_bytes()).map_err(|e| ExtrasError::Io {
+        whirlmap_results::write_atomic(&path, &kept).map_err(|e| ExtrasError::Io {
             path: e.path,
             source: e.source,
         })?;
@@ -86,18 +94,17 @@ impl DropLog {
             path,
             file: Mutex::new(file),
             known,
-            reused: Mutex::new(0),
+            reused: AtomicUsize::new(0),
             error: Mutex::new(None),
         })
     }
 
     /// The class an earlier run found for this coefficient, speed and scene, if it logged it.
     pub fn known(&self, mu: f64, speed_rpm: f64, scene_hash: &str) -> Option<OrbitClass> {
-        let (hash, class) = self.known.get(&(mu.to_bits(), speed_rpm.to_bits()))?;
-        (hash == scene_hash).then(|| {
-            *self.reused.lock().unwrap_or_else(|e| e.into_inner()) += 1;
-            *class
-        })
+        let key = (mu.to_bits(), speed_rpm.to_bits(), scene_hash.to_string());
+        let class = *self.known.get(&key)?;
+        self.reused.fetch_add(1, Ordering::Relaxed);
+        Some(class)
     }
 
     /// Appends one classified drop.
@@ -125,18 +132,17 @@ impl DropLog {
 
     /// How many drops were answered from the earlier run's lines.
     pub fn reused(&self) -> usize {
-        *self.reused.lock().unwrap_or_else(|e| e.into_inner())
+        self.reused.load(Ordering::Relaxed)
     }
 
-    /// The first failed append, if any (the search itself is unaffected: only what a later
-    /// resume could reuse is lost).
-    pub fn finish(self) -> Result<(), ExtrasError> {
-        match self.error.into_inner().unwrap_or_else(|e| e.into_inner()) {
-            Some(source) => Err(ExtrasError::Io {
-                path: self.path,
-                source,
-            }),
-            None => Ok(()),
-        }
+    /// The first failed append, if any, as a message: the search itself is unaffected, only
+    /// what a later resume could have reused is lost.
+    pub fn finish(self) -> Option<String> {
+        let error = self.error.into_inner().unwrap_or_else(|e| e.into_inner())?;
+        Some(format!(
+            "cannot append to {}: {error} (the search is complete; a resume would have run \
+             those drops again)",
+            self.path.display()
+        ))
     }
 }

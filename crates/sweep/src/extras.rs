@@ -204,7 +204,10 @@ fn run_critical_ticked(
         .map(|(_, mu)| mu)
         .collect();
     if let Some(rows) = resume.then(|| kept_critical(out_dir, &mus)).flatten() {
-        return write_critical(out_dir, &rows);
+        let written = write_critical(out_dir, &rows)?;
+        // A kill after the last run's critical.json and before its log was removed.
+        remove_drop_log(out_dir)?;
+        return Ok(written);
     }
     let rows = if mus.is_empty() {
         Vec::new()
@@ -219,24 +222,36 @@ fn run_critical_ticked(
             Some(&log),
         )
         .expect("the spec's critical section was validated");
-        if log.reused() > 0 {
+        let n = log.reused();
+        if n > 0 {
             eprintln!(
-                "sweep {}: critical search: {} drops reused from the killed run's {}",
+                "sweep {}: critical search: {n} drop{} reused from the killed run's {}",
                 spec.name,
-                log.reused(),
+                if n == 1 { "" } else { "s" },
                 CRITICAL_DROPS_FILE
             );
         }
-        log.finish()?;
+        if let Some(warning) = log.finish() {
+            eprintln!("warning: {warning}");
+        }
         rows
     };
     let written = write_critical(out_dir, &rows)?;
     // The log served its purpose: `critical.json` holds the search now.
-    let log = out_dir.join(CRITICAL_DROPS_FILE);
-    if log.exists() {
-        std::fs::remove_file(&log).map_err(|source| ExtrasError::Io { path: log, source })?;
-    }
+    remove_drop_log(out_dir)?;
     Ok(written)
+}
+
+/// Removes the critical search's drop log from `out_dir`, if there.
+fn remove_drop_log(out_dir: &Path) -> Result<(), ExtrasError> {
+    let log = out_dir.join(CRITICAL_DROPS_FILE);
+    match std::fs::remove_file(&log) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(ExtrasError::Io {
+            path: log,
+            source: e,
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// The rows of the `critical.json` a killed run of the same spec and build left in `out_dir`,
