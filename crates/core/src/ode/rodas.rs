@@ -125,68 +125,114 @@ impl<const N: usize> Rodas4<N> {
         h: f64,
     ) -> ([f64; N], f64) {
         let hg = h * GAMMA;
-        // The stages, unrolled: `sum_j coef_j u_j` with a constant number of terms.
-        #[inline(always)]
-        fn comb<const N: usize, const M: usize>(c: &[f64], u: &[[f64; N]; 6]) -> [f64; N] {
-            let mut v = [0.0; N];
-            for j in 0..M {
-                for i in 0..N {
-                    v[i] += c[j] * u[j][i];
-                }
-            }
-            v
-        }
         let mut u = [[0.0; N]; 6];
-        for i in 0..N {
-            u[0][i] = hg * f0[i];
-        }
-        lu.solve(&mut u[0]);
-        let mut yt = [0.0; N];
-        let mut f = [0.0; N];
-        // Stage s (0-based, 1..=5) at `yt` from the `s` stages before it.
-        macro_rules! stage {
-            ($s:literal, $m:literal) => {{
-                sys.rhs(t + C[$s] * h, &yt, &mut f);
-                let v = comb::<N, $m>(&CC[$s], &u);
-                let r = &mut u[$s];
-                for i in 0..N {
-                    r[i] = hg * f[i] + GAMMA * v[i];
-                }
-                lu.solve(r);
-            }};
-        }
-        macro_rules! point {
-            ($s:literal, $m:literal) => {{
-                let v = comb::<N, $m>(&A[$s], &u);
-                for i in 0..N {
-                    yt[i] = y[i] + v[i];
-                }
-            }};
-        }
-        point!(1, 1);
-        stage!(1, 1);
-        point!(2, 2);
-        stage!(2, 2);
-        point!(3, 3);
-        stage!(3, 3);
-        point!(4, 4);
-        stage!(4, 4);
+        first_stage(hg, f0, lu, &mut u);
+        let (mut yt, mut f) = ([0.0; N], [0.0; N]);
+        let st = |s: usize| (t + C[s] * h, hg, GAMMA);
+        point::<N, 1, 6>(y, &A[1], &u, &mut yt);
+        stage::<N, 1, 6, S>(sys, st(1), &CC[1], lu, &yt, &mut f, &mut u, 1);
+        point::<N, 2, 6>(y, &A[2], &u, &mut yt);
+        stage::<N, 2, 6, S>(sys, st(2), &CC[2], lu, &yt, &mut f, &mut u, 2);
+        point::<N, 3, 6>(y, &A[3], &u, &mut yt);
+        stage::<N, 3, 6, S>(sys, st(3), &CC[3], lu, &yt, &mut f, &mut u, 3);
+        point::<N, 4, 6>(y, &A[4], &u, &mut yt);
+        stage::<N, 4, 6, S>(sys, st(4), &CC[4], lu, &yt, &mut f, &mut u, 4);
         // Y_6 = Y_5 + u_5: the embedded solution.
         for i in 0..N {
             yt[i] += u[4][i];
         }
-        stage!(5, 5);
+        stage::<N, 5, 6, S>(sys, st(5), &CC[5], lu, &yt, &mut f, &mut u, 5);
         core.stats.rhs_evals += 5;
-        let mut y1 = [0.0; N];
-        let mut err = 0.0;
-        let atol = core.step_atol;
-        for i in 0..N {
-            y1[i] = yt[i] + u[5][i];
-            let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());
-            err += (u[5][i] / sc) * (u[5][i] / sc);
-        }
-        (y1, (err / N as f64).sqrt())
+        last_stage_end(core, y, &yt, &u[5])
     }
+}
+
+/// `sum_j c_j u_j` over the first `M` stages, unrolled (a constant number of terms, in
+/// order of `j`).
+#[inline(always)]
+pub(super) fn comb<const N: usize, const M: usize, const S: usize>(
+    c: &[f64],
+    u: &[[f64; N]; S],
+) -> [f64; N] {
+    let mut v = [0.0; N];
+    for j in 0..M {
+        for i in 0..N {
+            v[i] += c[j] * u[j][i];
+        }
+    }
+    v
+}
+
+/// The first stage of a RODAS-type step: `u_1 = W^-1 (h gamma f(y0))`.
+#[inline(always)]
+pub(super) fn first_stage<const N: usize, const S: usize>(
+    hg: f64,
+    f0: &[f64; N],
+    lu: &Lu,
+    u: &mut [[f64; N]; S],
+) {
+    for i in 0..N {
+        u[0][i] = hg * f0[i];
+    }
+    lu.solve(&mut u[0]);
+}
+
+/// A stage point from the `a_sj` row `a` of the stages before it: `yt = y0 + sum_j a_sj u_j`.
+#[inline(always)]
+pub(super) fn point<const N: usize, const M: usize, const S: usize>(
+    y: &[f64; N],
+    a: &[f64],
+    u: &[[f64; N]; S],
+    yt: &mut [f64; N],
+) {
+    let v = comb::<N, M, S>(a, u);
+    for i in 0..N {
+        yt[i] = y[i] + v[i];
+    }
+}
+
+/// Stage `s` (0-based) at `yt` from the `M = s` stages before it, `(t_s, h gamma, gamma)` its
+/// time and the method's diagonal: `u_s = W^-1 (h gamma f(t_s, yt) + gamma sum_j c_sj u_j)`,
+/// with `f` as scratch for the derivative.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn stage<const N: usize, const M: usize, const S: usize, Sys: OdeSystem<N>>(
+    sys: &Sys,
+    (t_s, hg, gamma): (f64, f64, f64),
+    cc: &[f64],
+    lu: &Lu,
+    yt: &[f64; N],
+    f: &mut [f64; N],
+    u: &mut [[f64; N]; S],
+    s: usize,
+) {
+    sys.rhs(t_s, yt, f);
+    let v = comb::<N, M, S>(cc, u);
+    let r = &mut u[s];
+    for i in 0..N {
+        r[i] = hg * f[i] + gamma * v[i];
+    }
+    lu.solve(r);
+}
+
+/// The step's end `y1 = yt + u_last` (the stiffly accurate solution after the embedded one at
+/// `yt`) and the error norm of `u_last`, scaled by the step's tolerances.
+#[inline(always)]
+pub(super) fn last_stage_end<const N: usize>(
+    core: &StepCore<N>,
+    y: &[f64; N],
+    yt: &[f64; N],
+    last: &[f64; N],
+) -> ([f64; N], f64) {
+    let mut y1 = [0.0; N];
+    let mut err = 0.0;
+    let atol = core.step_atol;
+    for i in 0..N {
+        y1[i] = yt[i] + last[i];
+        let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());
+        err += (last[i] / sc) * (last[i] / sc);
+    }
+    (y1, (err / N as f64).sqrt())
 }
 
 impl<const N: usize> Stepper<N> for Rodas4<N> {

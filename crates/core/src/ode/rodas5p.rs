@@ -13,6 +13,7 @@
 //! Hermite interpolant of the step's ends (order 3) would lose to it on steps this long.
 
 use super::control::{StepCore, StepLaw};
+use super::rodas::{comb, first_stage, last_stage_end, point, stage};
 use super::rosw::{rosenbrock_step, Lu, Rosenbrock};
 use super::step::{Dense, StepControl};
 use super::stepper::Stepper;
@@ -198,75 +199,35 @@ impl<const N: usize> Rodas5p<N> {
         h: f64,
     ) -> ([f64; N], f64) {
         let hg = h * GAMMA;
-        #[inline(always)]
-        fn comb<const N: usize, const M: usize>(c: &[f64], u: &[[f64; N]; 8]) -> [f64; N] {
-            let mut v = [0.0; N];
-            for j in 0..M {
-                for i in 0..N {
-                    v[i] += c[j] * u[j][i];
-                }
-            }
-            v
-        }
         let mut u = [[0.0; N]; 8];
-        for i in 0..N {
-            u[0][i] = hg * f0[i];
-        }
-        lu.solve(&mut u[0]);
-        let mut yt = [0.0; N];
-        let mut f = [0.0; N];
-        macro_rules! stage {
-            ($s:literal, $m:literal) => {{
-                sys.rhs(t + C[$s] * h, &yt, &mut f);
-                let v = comb::<N, $m>(&CC[$s], &u);
-                let r = &mut u[$s];
-                for i in 0..N {
-                    r[i] = hg * f[i] + GAMMA * v[i];
-                }
-                lu.solve(r);
-            }};
-        }
-        macro_rules! point {
-            ($s:literal, $m:literal) => {{
-                let v = comb::<N, $m>(&A[$s], &u);
-                for i in 0..N {
-                    yt[i] = y[i] + v[i];
-                }
-            }};
-        }
-        point!(1, 1);
-        stage!(1, 1);
-        point!(2, 2);
-        stage!(2, 2);
-        point!(3, 3);
-        stage!(3, 3);
-        point!(4, 4);
-        stage!(4, 4);
-        point!(5, 5);
-        stage!(5, 5);
+        first_stage(hg, f0, lu, &mut u);
+        let (mut yt, mut f) = ([0.0; N], [0.0; N]);
+        let st = |s: usize| (t + C[s] * h, hg, GAMMA);
+        point::<N, 1, 8>(y, &A[1], &u, &mut yt);
+        stage::<N, 1, 8, S>(sys, st(1), &CC[1], lu, &yt, &mut f, &mut u, 1);
+        point::<N, 2, 8>(y, &A[2], &u, &mut yt);
+        stage::<N, 2, 8, S>(sys, st(2), &CC[2], lu, &yt, &mut f, &mut u, 2);
+        point::<N, 3, 8>(y, &A[3], &u, &mut yt);
+        stage::<N, 3, 8, S>(sys, st(3), &CC[3], lu, &yt, &mut f, &mut u, 3);
+        point::<N, 4, 8>(y, &A[4], &u, &mut yt);
+        stage::<N, 4, 8, S>(sys, st(4), &CC[4], lu, &yt, &mut f, &mut u, 4);
+        point::<N, 5, 8>(y, &A[5], &u, &mut yt);
+        stage::<N, 5, 8, S>(sys, st(5), &CC[5], lu, &yt, &mut f, &mut u, 5);
+        // Y_7 = Y_6 + u_6, then Y_8 = Y_7 + u_7: the embedded solution.
         for i in 0..N {
             yt[i] += u[5][i];
         }
-        stage!(6, 6);
-        // Y_8 = Y_7 + u_7: the embedded solution.
+        stage::<N, 6, 8, S>(sys, st(6), &CC[6], lu, &yt, &mut f, &mut u, 6);
         for i in 0..N {
             yt[i] += u[6][i];
         }
-        stage!(7, 7);
+        stage::<N, 7, 8, S>(sys, st(7), &CC[7], lu, &yt, &mut f, &mut u, 7);
         core.stats.rhs_evals += 7;
         // The interpolant's K1..K3 into the dense rows 5-7 ([`Rosenbrock::own_dense`]).
         for (row, h_r) in core.dense.r[5..8].iter_mut().zip(&H) {
-            *row = comb::<N, 8>(h_r, &u);
+            *row = comb::<N, 8, 8>(h_r, &u);
         }
-        let mut y1 = [0.0; N];
-        let mut err = 0.0;
-        let atol = core.step_atol;
-        for i in 0..N {
-            y1[i] = yt[i] + u[7][i];
-            let sc = atol[i] + core.ctl.rtol * y[i].abs().max(y1[i].abs());
-            err += (u[7][i] / sc) * (u[7][i] / sc);
-        }
-        (y1, (err / N as f64).sqrt())
+        last_stage_end(core, y, &yt, &u[7])
     }
 }
 
