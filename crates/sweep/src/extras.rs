@@ -223,16 +223,17 @@ fn run_critical_ticked(
         )
         .expect("the spec's critical section was validated");
         let n = log.reused();
+        // Through `progress_line`: a closed standard error must not panic the run.
         if n > 0 {
-            eprintln!(
+            crate::progress::progress_line(&format!(
                 "sweep {}: critical search: {n} drop{} reused from the killed run's {}",
                 spec.name,
                 if n == 1 { "" } else { "s" },
                 CRITICAL_DROPS_FILE
-            );
+            ));
         }
         if let Some(warning) = log.finish() {
-            eprintln!("warning: {warning}");
+            crate::progress::progress_line(&format!("warning: {warning}"));
         }
         rows
     };
