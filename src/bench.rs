@@ -73,7 +73,7 @@ struct Case {
 /// ratio to the baseline (the first row) and to the peer, and the work counts.
 pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
     let reps = a.reps;
-    let cases: [Case; 9] = [
+    let cases: [Case; 11] = [
         Case {
             name: "pendulum 1 s, standard (baseline)",
             speed_rpm: 8000.0,
@@ -130,6 +130,26 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             speed_rpm: 30_000.0,
             mu: 0.1,
             edit: |_| {},
+        }, // A tight study's two Rosenbrock methods, with the gap bound alone
+        // (docs/accuracy.md#rodas5p-measured).
+        Case {
+            name: "pendulum 1 s, rodas4 rtol 1e-6, gap only",
+            speed_rpm: 8000.0,
+            mu: 0.1,
+            edit: |s| {
+                s.solver.rtol = 1e-6;
+                s.solver.race_velocity_atol_from_force = false;
+            },
+        },
+        Case {
+            name: "pendulum 1 s, rodas5p rtol 1e-6, gap only",
+            speed_rpm: 8000.0,
+            mu: 0.1,
+            edit: |s| {
+                s.solver.rtol = 1e-6;
+                s.solver.race_velocity_atol_from_force = false;
+                s.solver.method = whirlmap_core::Method::Rodas5p;
+            },
         },
     ];
     outln!(
