@@ -92,7 +92,8 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
 /// The study's own record, from which its charts can be drawn again.
 const STUDY_FILE: &str = "study.json";
 
-/// The `study.json` in `out`, checked to be a study of `spec`'s cases (exit 2 otherwise).
+/// The `study.json` in `out`, checked to be a study of `spec`'s cases and settings (exit 2
+/// otherwise).
 fn read_study(out: &std::path::Path, spec: &AccuracySpec) -> Result<Study, Failure> {
     let path = out.join(STUDY_FILE);
     let text = std::fs::read_to_string(&path)
