@@ -59,6 +59,10 @@ pub struct AdaptiveArgs {
     /// Also run the full fine grid and report how the boundaries agree.
     #[arg(long)]
     compare_full: bool,
+    /// Continue a search that was killed in this output folder (the same spec and build): the
+    /// corners it logged are not evaluated again.
+    #[arg(long, conflicts_with = "overwrite")]
+    resume: bool,
 }
 
 /// The command's failure for a library error.
@@ -78,14 +82,24 @@ fn load(
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("results").join(&s.name));
-    // A folder without an ensemble's manifest has nothing to resume: it is refused as any
-    // folder with results is.
-    if !resume || !out.join(ensemble::MANIFEST_FILE).exists() {
+    // A folder without what a killed run leaves (an ensemble's manifest, an adaptive search's
+    // corner log) has nothing to resume: it is refused as any folder with results is.
+    let marker = if what == "adaptive" {
+        whirlmap_sweep::results::files::ADAPTIVE_CORNERS_FILE
+    } else {
+        ensemble::MANIFEST_FILE
+    };
+    if !resume || !out.join(marker).exists() {
         crate::refuse_existing_results(&out, a.overwrite).map_err(|e| {
             if what == "ensemble" && !resume {
                 Failure::Input(anyhow::anyhow!(
                     "{e}; --resume continues an ensemble that did not finish there, keeping \
                      its members"
+                ))
+            } else if what == "adaptive" && !resume && out.join(marker).exists() {
+                Failure::Input(anyhow::anyhow!(
+                    "{e}; --resume continues the adaptive search that did not finish there, \
+                     keeping its evaluated corners"
                 ))
             } else {
                 Failure::Input(e)
@@ -174,13 +188,14 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
 /// Runs `whirlmap adaptive`.
 pub fn run_adaptive_cmd(args: &AdaptiveArgs) -> CmdResult {
     let a = &args.common;
-    let (spec, out, _lock) = load(a, "adaptive", false)?;
+    let (spec, out, _lock) = load(a, "adaptive", args.resume)?;
     let (r, path) = run_adaptive(
         &spec,
         &out,
         a.threads.map(|n| n as usize),
         args.compare_full,
         !a.no_progress,
+        args.resume,
     )
     .map_err(failure)?;
     outln!(

@@ -358,3 +358,126 @@ fn a_killed_ensemble_keeps_its_members_and_resumes_to_the_uninterrupted_files() 
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+const ADAPTIVE_RESUME: &str = r#"{"name": "ar", "duration_s": 0.2,
+    "scene": {"solver": {"rtol": 1e-6}},
+    "axes": {"speed_rpm": {"from": 2000, "to": 18000, "steps": 17},
+             "mu": {"from": 0.2, "to": 0.5, "steps": 9}},
+    "adaptive": {"seed_speed_points": 5, "seed_mu_points": 3}}"#;
+
+/// A killed adaptive search keeps the corners it evaluated (`adaptive-corners.jsonl`):
+/// `--resume` evaluates only the others and writes the `adaptive.json` of an uninterrupted run,
+/// then removes the log; without `--resume` the folder is refused with a hint.
+#[test]
+fn a_killed_adaptive_search_resumes_to_the_uninterrupted_report() {
+    let dir = temp_dir("adaptive-resume");
+    let f = dir.join("ar.json");
+    std::fs::write(&f, ADAPTIVE_RESUME).unwrap();
+    let (full, killed) = (dir.join("full"), dir.join("killed"));
+    let run = |out: &Path, extra: &[&str]| {
+        let mut a = vec!["adaptive", s(&f), "--out", s(out), "--compare-full"];
+        a.extend_from_slice(extra);
+        a.push("--no-progress");
+        whirlmap(&a)
+    };
+    let o = run(&full, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!full.join("adaptive-corners.jsonl").exists());
+    let log = killed.join("adaptive-corners.jsonl");
+    // The header and the seed (15 corners) are in, and at least one more round.
+    let args = [
+        "adaptive",
+        s(&f),
+        "--out",
+        s(&killed),
+        "--compare-full",
+        "--threads",
+        "1",
+        "--no-progress",
+    ];
+    kill_after_lines(&args, &log, 17);
+    assert!(!killed.join("adaptive.json").exists(), "killed mid-search");
+    let o = run(&killed, &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("--resume continues the adaptive search"),
+        "{err}"
+    );
+    let o = run(&killed, &["--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("corners kept from the killed run"), "{err}");
+    assert_eq!(
+        read(&killed.join("adaptive.json")),
+        read(&full.join("adaptive.json"))
+    );
+    assert!(!log.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// What a resumed adaptive search takes from a staged log: a logged corner's value is used
+/// (a marked value shows up in the report), a torn last line is not, and a log of another
+/// spec is refused (exit 2).
+#[test]
+fn a_resumed_adaptive_search_uses_its_logged_corners_and_refuses_another_specs() {
+    let dir = temp_dir("adaptive-log");
+    let f = dir.join("ar.json");
+    std::fs::write(&f, ADAPTIVE_RESUME).unwrap();
+    let out = dir.join("out");
+    let resume = || {
+        whirlmap(&[
+            "adaptive",
+            s(&f),
+            "--out",
+            s(&out),
+            "--resume",
+            "--no-progress",
+        ])
+    };
+    // A first run leaves no log; its header is rebuilt from a fresh, killed one.
+    std::fs::create_dir_all(&out).unwrap();
+    let args = [
+        "adaptive",
+        s(&f),
+        "--out",
+        s(&out),
+        "--threads",
+        "1",
+        "--no-progress",
+    ];
+    kill_after_lines(&args, &out.join("adaptive-corners.jsonl"), 1);
+    let text = read(&out.join("adaptive-corners.jsonl"));
+    let header = text.lines().next().unwrap().to_string();
+    // Corner (0, 0) is a seed corner; 0.25 is a value no single drop gives.
+    let staged = format!(
+        "{header}\n{}\n{}",
+        r#"{"i":0,"j":0,"p_whirl":0.25}"#, r#"{"i":16,"j":8,"p_whirl":0.75}"#
+    );
+    std::fs::write(out.join("adaptive-corners.jsonl"), &staged).unwrap();
+    let o = resume();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_str(&read(&out.join("adaptive.json"))).unwrap();
+    let p_at = |speed: f64, mu: f64| {
+        r["evaluated"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["speed_rpm"] == speed && (c["mu"].as_f64().unwrap() - mu).abs() < 1e-12)
+            .map(|c| c["p_whirl"].as_f64().unwrap())
+    };
+    assert_eq!(p_at(2000.0, 0.2), Some(0.25), "the logged corner is used");
+    let top = p_at(18000.0, 0.5).expect("a seed corner");
+    assert!(top == 0.0 || top == 1.0, "the torn line is not used: {top}");
+
+    // A log of another spec (another duration) is refused, naming why.
+    std::fs::remove_file(out.join("adaptive.json")).unwrap();
+    let other = header.replace("\"duration_s\":0.2", "\"duration_s\":0.3");
+    assert_ne!(other, header);
+    std::fs::write(out.join("adaptive-corners.jsonl"), format!("{other}\n")).unwrap();
+    let o = resume();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("another spec"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -48,6 +48,10 @@ pub const CELLS_FILE: &str = "cells.jsonl";
 pub const CONTOURS_FILE: &str = "contours.json";
 /// The adaptive refinement's results.
 pub const ADAPTIVE_FILE: &str = "adaptive.json";
+/// The adaptive refinement's evaluated corners while it runs (a header line with the spec and
+/// the build, then one JSON line per corner; `--resume` reuses them); removed once
+/// [`ADAPTIVE_FILE`] is written.
+pub const ADAPTIVE_CORNERS_FILE: &str = "adaptive-corners.jsonl";
 
 /// The file name of a recorded orbit (in [`ORBITS_DIR`]): `stem.json`.
 pub fn orbit_file(stem: &str) -> String {

@@ -421,13 +421,17 @@ fn evaluate_points(spec: &EnsembleSpec, cells: &[&Cell]) -> Vec<f64> {
 }
 
 /// Runs the adaptive search of `spec` (and, with `compare_full`, the full grid) and writes
-/// `adaptive.json` to `out_dir`.
+/// `adaptive.json` to `out_dir`. Every evaluated corner is logged while the search runs
+/// ([`crate::adaptive_log`]); with `resume`, the corners a killed run of the same spec and
+/// build logged there are not evaluated again. The log is removed once `adaptive.json` is
+/// written.
 pub fn run_adaptive(
     spec: &EnsembleSpec,
     out_dir: &Path,
     threads: Option<usize>,
     compare_full: bool,
     show_progress: bool,
+    resume: bool,
 ) -> Result<(AdaptiveReport, PathBuf), SweepError> {
     let cells = spec.cells()?;
     let params = spec.adaptive.clone().ok_or_else(|| SpecError::Invalid {
@@ -448,11 +452,40 @@ pub fn run_adaptive(
         };
         &cells[k]
     };
+    let mut log = crate::adaptive_log::CornerLog::open(out_dir, spec, resume)?;
+    if log.known_len() > 0 {
+        crate::sweep::progress_line(&format!(
+            "adaptive {}: {} corners kept from the killed run's {}",
+            spec.name,
+            log.known_len(),
+            whirlmap_results::files::ADAPTIVE_CORNERS_FILE
+        ));
+    }
+    // The first failed append: the search goes on, and the run reports it at the end.
+    let mut log_error = None;
     let start = Instant::now();
     let mut done = 0usize;
     let mut eval = |pts: &[(usize, usize)]| {
-        let batch: Vec<&Cell> = pts.iter().map(|p| cell_at(*p)).collect();
-        let v = pool.install(|| evaluate_points(spec, &batch));
+        // The corners the log knows keep their values; the others are evaluated and logged.
+        let todo: Vec<(usize, usize)> = pts
+            .iter()
+            .copied()
+            .filter(|p| log.known(*p).is_none())
+            .collect();
+        let batch: Vec<&Cell> = todo.iter().map(|p| cell_at(*p)).collect();
+        let fresh = pool.install(|| evaluate_points(spec, &batch));
+        let fresh: Vec<((usize, usize), f64)> = todo.into_iter().zip(fresh).collect();
+        if let Err(e) = log.record(&fresh) {
+            log_error.get_or_insert(e);
+        }
+        let mut fresh = fresh.into_iter();
+        let v: Vec<f64> = pts
+            .iter()
+            .map(|p| {
+                log.known(*p)
+                    .unwrap_or_else(|| fresh.next().expect("one value per new corner").1)
+            })
+            .collect();
         done += pts.len();
         if show_progress {
             crate::sweep::progress_line(&format!(
@@ -533,6 +566,11 @@ pub fn run_adaptive(
     };
     let path = out_dir.join(ADAPTIVE_FILE);
     crate::folder::write_atomic(&path, report.to_text().as_bytes())?;
+    // A failed append lost only what a resume could have kept: the search is complete.
+    if let Some(e) = log_error {
+        crate::sweep::progress_line(&format!("warning: the corner log: {e}"));
+    }
+    log.remove()?;
     Ok((report, path))
 }
 

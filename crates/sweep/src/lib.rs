@@ -27,6 +27,7 @@ pub use whirlmap_results as results;
 
 pub mod accuracy;
 pub mod adaptive;
+pub mod adaptive_log;
 pub mod build_info;
 pub mod classify;
 pub mod compare;
