@@ -18,7 +18,8 @@ pub struct EnsembleArgs {
     /// section (and, for `adaptive`, an `adaptive` section).
     file: PathBuf,
     /// Output folder; default `results/<name>`. A folder that already holds results (a
-    /// committed one among them) is refused without --overwrite.
+    /// committed one among them) is refused without --overwrite (or --resume, for a run killed
+    /// there).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Replace the results already in the output folder.
@@ -49,8 +50,8 @@ pub struct EnsembleCmdArgs {
     resume: bool,
 }
 
-/// Arguments of `whirlmap adaptive`: those of `ensemble`, and `--compare-full` (which only
-/// an adaptive map has, so `ensemble` refuses it).
+/// Arguments of `whirlmap adaptive`: those of `ensemble`, `--compare-full` (which only an
+/// adaptive map has, so `ensemble` refuses it) and `--resume`.
 #[derive(clap::Args)]
 pub struct AdaptiveArgs {
     /// The arguments `ensemble` takes too.

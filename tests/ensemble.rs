@@ -418,7 +418,7 @@ fn a_killed_adaptive_search_resumes_to_the_uninterrupted_report() {
 
 /// What a resumed adaptive search takes from a staged log: a logged corner's value is used
 /// (a marked value shows up in the report), a torn last line is not, and a log of another
-/// spec is refused (exit 2).
+/// spec or build is refused (exit 2).
 #[test]
 fn a_resumed_adaptive_search_uses_its_logged_corners_and_refuses_another_specs() {
     let dir = temp_dir("adaptive-log");
@@ -479,5 +479,13 @@ fn a_resumed_adaptive_search_uses_its_logged_corners_and_refuses_another_specs()
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("another spec"), "{err}");
+    // So is a log of another build (another commit).
+    let commit = header.find("\"git_commit\":\"").expect("a commit") + 14;
+    let other = format!("{}x{}", &header[..commit], &header[commit..]);
+    std::fs::write(out.join("adaptive-corners.jsonl"), format!("{other}\n")).unwrap();
+    let o = resume();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("another build"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }

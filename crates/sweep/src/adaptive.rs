@@ -24,12 +24,13 @@
 //! fine enough for those.
 //!
 //! ## Use
-//! `whirlmap adaptive FILE [--compare-full]`: the file is an ensemble file
+//! `whirlmap adaptive FILE [--compare-full] [--resume]`: the file is an ensemble file
 //! ([`crate::ensemble`]) with exactly the axes `speed_rpm` and `mu` and an `adaptive`
 //! section ([`AdaptiveParams`]); with an `ensemble` section each corner is an ensemble and
 //! its value P(whirl), else one drop (whirl 1, else 0). `--compare-full` also evaluates
 //! every fine point (reusing the corners already run: same inputs, same result) and reports
-//! how far the boundaries lie apart.
+//! how far the boundaries lie apart. `--resume` continues a search killed in its folder,
+//! reusing the corners it logged ([`crate::adaptive_log`]).
 
 use crate::ensemble::{self, first_crossing, Cell, EnsembleSpec};
 use crate::spec::{check_output_dir, SpecError};
@@ -452,7 +453,7 @@ pub fn run_adaptive(
         };
         &cells[k]
     };
-    let mut log = crate::adaptive_log::CornerLog::open(out_dir, spec, resume)?;
+    let mut log = crate::adaptive_log::CornerLog::open(out_dir, spec, shape, resume)?;
     if log.known_len() > 0 {
         crate::sweep::progress_line(&format!(
             "adaptive {}: {} corners kept from the killed run's {}",
@@ -472,11 +473,19 @@ pub fn run_adaptive(
             .copied()
             .filter(|p| log.known(*p).is_none())
             .collect();
-        let batch: Vec<&Cell> = todo.iter().map(|p| cell_at(*p)).collect();
-        let fresh = pool.install(|| evaluate_points(spec, &batch));
-        let fresh: Vec<((usize, usize), f64)> = todo.into_iter().zip(fresh).collect();
-        if let Err(e) = log.record(&fresh) {
-            log_error.get_or_insert(e);
+        // In chunks of a few corners per thread, each logged as it is done, so a kill loses
+        // one chunk rather than a whole round (or the whole comparison with the full grid).
+        // Each corner's value is its own: the chunking changes no value.
+        let chunk = 4 * pool.current_num_threads();
+        let mut fresh: Vec<((usize, usize), f64)> = Vec::with_capacity(todo.len());
+        for part in todo.chunks(chunk) {
+            let batch: Vec<&Cell> = part.iter().map(|p| cell_at(*p)).collect();
+            let values = pool.install(|| evaluate_points(spec, &batch));
+            let done_part: Vec<((usize, usize), f64)> = part.iter().copied().zip(values).collect();
+            if let Err(e) = log.record(&done_part) {
+                log_error.get_or_insert(e);
+            }
+            fresh.extend(done_part);
         }
         let mut fresh = fresh.into_iter();
         let v: Vec<f64> = pts
@@ -566,11 +575,14 @@ pub fn run_adaptive(
     };
     let path = out_dir.join(ADAPTIVE_FILE);
     crate::folder::write_atomic(&path, report.to_text().as_bytes())?;
-    // A failed append lost only what a resume could have kept: the search is complete.
+    // A failed append or removal loses only what a resume could have kept: the search is
+    // complete and written.
     if let Some(e) = log_error {
         crate::sweep::progress_line(&format!("warning: the corner log: {e}"));
     }
-    log.remove()?;
+    if let Err(e) = log.remove() {
+        crate::sweep::progress_line(&format!("warning: the corner log: {e}"));
+    }
     Ok((report, path))
 }
 

@@ -3,9 +3,9 @@
 //! continued with `--resume` does not evaluate them again.
 //!
 //! The first line records the spec and the build; each further line is one corner, `i` and
-//! `j` on the fine grid and its `p_whirl`, appended with one `write_all` when its round's
-//! batch is done, so a kill loses at most the batch in flight (and a torn last line, which a
-//! resume cuts). A failed corner (`p_whirl` NaN) is not logged: it runs again. The search is a
+//! `j` on the fine grid and its `p_whirl`, appended with one `write_all` per chunk of a batch
+//! (a few corners per thread), so a kill loses at most the chunk in flight (and a torn last
+//! line, which a resume cuts). A failed corner (`p_whirl` NaN) is not logged: it runs again. The search is a
 //! function of its corners' values, so a resumed search writes the `adaptive.json` an
 //! uninterrupted one writes. A resume refuses a log of another spec or build; the log is
 //! removed once `adaptive.json` is written. It is appended and not synced: a power loss may
@@ -14,6 +14,7 @@
 use crate::ensemble::EnsembleSpec;
 use crate::sweep::SweepError;
 use serde::{Deserialize, Serialize};
+use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 use std::fs::File;
 use std::io::Write;
@@ -47,14 +48,21 @@ pub struct CornerLog {
 }
 
 impl CornerLog {
-    /// Opens the log in `out_dir` for `spec`. With `resume`, the corners an earlier run of the
-    /// same spec and build logged are known (a log of another spec or build is refused, exit
-    /// 2), and the file is rewritten with its header and the corner lines that can be read (a
-    /// torn last line is dropped); otherwise, or when there is no log, it starts with a new
+    /// Opens the log in `out_dir` for `spec` on a fine grid of `shape` points. With `resume`,
+    /// the corners an earlier run of the same spec and build logged are known (a log of another
+    /// spec or build is refused, exit 2), and the file is rewritten with its header and the
+    /// corner lines it keeps: whole lines that can be read, of a point on the grid, with a
+    /// value in [0, 1], the first of a point (a torn last line, or anything else, is dropped,
+    /// and that corner runs again); otherwise, or when there is no log, it starts with a new
     /// header.
-    pub fn open(out_dir: &Path, spec: &EnsembleSpec, resume: bool) -> Result<Self, SweepError> {
+    pub fn open(
+        out_dir: &Path,
+        spec: &EnsembleSpec,
+        shape: (usize, usize),
+        resume: bool,
+    ) -> Result<Self, SweepError> {
         let path = out_dir.join(ADAPTIVE_CORNERS_FILE);
-        let io = |e| crate::folder::output_error(&path, e);
+        let io = |e| crate::sweep::io_err(&path)(e);
         let spec_value = serde_json::to_value(spec).expect("specs serialise");
         let header = Header {
             spec: spec_value.clone(),
@@ -103,10 +111,16 @@ impl CornerLog {
                 )));
             }
             for line in lines {
-                if let Ok(c) = serde_json::from_slice::<Corner>(line) {
-                    if c.p_whirl.is_finite() && known.insert((c.i, c.j), c.p_whirl).is_none() {
-                        text.push_str(std::str::from_utf8(line).unwrap_or_default());
-                    }
+                let (Ok(c), Ok(line)) = (
+                    serde_json::from_slice::<Corner>(line),
+                    std::str::from_utf8(line),
+                ) else {
+                    continue;
+                };
+                let on_grid = c.i < shape.0 && c.j < shape.1 && (0.0..=1.0).contains(&c.p_whirl);
+                if let (true, Entry::Vacant(v)) = (on_grid, known.entry((c.i, c.j))) {
+                    v.insert(c.p_whirl);
+                    text.push_str(line);
                 }
             }
         }
@@ -124,7 +138,7 @@ impl CornerLog {
         self.known.get(&p).copied()
     }
 
-    /// How many corners the earlier run left.
+    /// How many corners of the earlier run are kept.
     pub fn known_len(&self) -> usize {
         self.known.len()
     }
@@ -138,7 +152,7 @@ impl CornerLog {
         }
         self.file
             .write_all(text.as_bytes())
-            .map_err(|e| crate::folder::output_error(&self.path, e))
+            .map_err(crate::sweep::io_err(&self.path))
     }
 
     /// Removes the log (once `adaptive.json` holds the search).
@@ -146,7 +160,7 @@ impl CornerLog {
         drop(self.file);
         match std::fs::remove_file(&self.path) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                Err(crate::folder::output_error(&self.path, e))
+                Err(crate::sweep::io_err(&self.path)(e))
             }
             _ => Ok(()),
         }

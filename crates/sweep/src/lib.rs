@@ -15,7 +15,8 @@
 //! - [`compare`]: what changed between two results (nightly jobs).
 //! - [`accuracy`]: the work-precision study (`whirlmap accuracy`).
 //! - [`ensemble`]: whirl probability per cell (seeded ensembles of drops), probability
-//!   contours; [`adaptive`]: adaptive refinement of the whirl boundary.
+//!   contours; [`adaptive`]: adaptive refinement of the whirl boundary;
+//!   [`adaptive_log`] and [`critical_log`]: what a killed search finished, for `--resume`.
 //!
 //! No charts: drawing is `whirlmap-plot`'s, which reads what this crate writes. A merge
 //! and a comparison take the drawing as a function from their caller.
