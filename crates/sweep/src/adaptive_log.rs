@@ -5,9 +5,9 @@
 //! The first line records the spec and the build; each further line is one corner, `i` and
 //! `j` on the fine grid and its `p_whirl`, appended with one `write_all` per chunk of a batch
 //! (a few corners per thread), so a kill loses at most the chunk in flight (and a torn last
-//! line, which a resume cuts). A failed corner (`p_whirl` NaN) is not logged: it runs again. The search is a
-//! function of its corners' values, so a resumed search writes the `adaptive.json` an
-//! uninterrupted one writes. A resume refuses a log of another spec or build; the log is
+//! line, which a resume cuts). A failed corner (`p_whirl` NaN) is not logged: it runs again.
+//! The search is a function of its corners' values, so a resumed search writes the
+//! `adaptive.json` an uninterrupted one writes. A resume refuses a log of another spec or build; the log is
 //! removed once `adaptive.json` is written. It is appended and not synced: a power loss may
 //! lose its last lines, and those corners run again.
 
