@@ -468,32 +468,30 @@ pub fn run_adaptive(
     let mut done = 0usize;
     let mut eval = |pts: &[(usize, usize)]| {
         // The corners the log knows keep their values; the others are evaluated and logged.
-        let todo: Vec<(usize, usize)> = pts
-            .iter()
-            .copied()
-            .filter(|p| log.known(*p).is_none())
-            .collect();
+        let mut values: Vec<Option<f64>> = pts.iter().map(|p| log.known(*p)).collect();
+        let todo: Vec<usize> = (0..pts.len()).filter(|&k| values[k].is_none()).collect();
         // In chunks of a few corners per thread, each logged as it is done, so a kill loses
         // one chunk rather than a whole round (or the whole comparison with the full grid).
         // Each corner's value is its own: the chunking changes no value.
         let chunk = 4 * pool.current_num_threads();
-        let mut fresh: Vec<((usize, usize), f64)> = Vec::with_capacity(todo.len());
         for part in todo.chunks(chunk) {
-            let batch: Vec<&Cell> = part.iter().map(|p| cell_at(*p)).collect();
-            let values = pool.install(|| evaluate_points(spec, &batch));
-            let done_part: Vec<((usize, usize), f64)> = part.iter().copied().zip(values).collect();
-            if let Err(e) = log.record(&done_part) {
+            let batch: Vec<&Cell> = part.iter().map(|&k| cell_at(pts[k])).collect();
+            let fresh = pool.install(|| evaluate_points(spec, &batch));
+            let done: Vec<((usize, usize), f64)> = part
+                .iter()
+                .map(|&k| pts[k])
+                .zip(fresh.iter().copied())
+                .collect();
+            if let Err(e) = log.record(&done) {
                 log_error.get_or_insert(e);
             }
-            fresh.extend(done_part);
+            for (&k, p) in part.iter().zip(fresh) {
+                values[k] = Some(p);
+            }
         }
-        let mut fresh = fresh.into_iter();
-        let v: Vec<f64> = pts
-            .iter()
-            .map(|p| {
-                log.known(*p)
-                    .unwrap_or_else(|| fresh.next().expect("one value per new corner").1)
-            })
+        let v: Vec<f64> = values
+            .into_iter()
+            .map(|p| p.expect("every corner known or evaluated"))
             .collect();
         done += pts.len();
         if show_progress {

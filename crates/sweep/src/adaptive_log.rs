@@ -82,9 +82,8 @@ impl CornerLog {
             Vec::new()
         };
         // Only whole lines: a line without its newline was cut by the kill.
-        let mut lines = bytes
-            .split_inclusive(|b| *b == b'\n')
-            .filter(|l| l.ends_with(b"\n"));
+        let whole = &bytes[..whirlmap_results::read::complete_len(&bytes)];
+        let mut lines = whole.split_inclusive(|b| *b == b'\n');
         if let Some(first) = lines.next() {
             let refuse = |why: String| {
                 SweepError::Refused(format!(

@@ -65,10 +65,8 @@ impl DropLog {
                 Err(e) => return Err(io(e)),
             };
             // Only whole lines: a line without its newline was cut by the kill.
-            for line in bytes.split_inclusive(|b| *b == b'\n') {
-                if !line.ends_with(b"\n") {
-                    continue;
-                }
+            let whole = &bytes[..whirlmap_results::read::complete_len(&bytes)];
+            for line in whole.split_inclusive(|b| *b == b'\n') {
                 if let Ok(l) = serde_json::from_slice::<Line>(line) {
                     known.insert(
                         (l.mu.to_bits(), l.speed_rpm.to_bits(), l.scene_hash),
