@@ -8,6 +8,10 @@
 //! a row's onset undecided (`undecided`, see docs/critical-speed.md) the command still prints
 //! and writes every row, names the friction coefficients on standard error and exits 1, as a
 //! sweep whose points failed does.
+//!
+//! `--log FILE` keeps every classified drop in FILE and answers from it the drops it already
+//! holds ([`DropLog::open_kept`]): a killed search run again does only what is missing, and
+//! the rows are those of an uninterrupted run (each is a function of its drops' classes).
 
 use crate::{build_scene, CmdResult, Done, Failure};
 use std::path::PathBuf;
@@ -15,9 +19,10 @@ use std::time::Instant;
 use whirlmap_core::InvalidParameter;
 use whirlmap_sweep::critical::undecided_summary;
 use whirlmap_sweep::critical::{
-    check_mus, critical_rows_ticked, csv_text, fmt_rpm, CriticalOptions, CriticalRow,
+    check_mus, critical_rows_logged, csv_text, fmt_rpm, CriticalOptions, CriticalRow,
     DEFAULT_RESOLUTION_RPM, DEFAULT_TOL_RPM,
 };
+use whirlmap_sweep::critical_log::DropLog;
 use whirlmap_sweep::progress::Ticker;
 use whirlmap_sweep::recheck::recheck_bracket;
 
@@ -61,6 +66,12 @@ pub struct CriticalArgs {
     /// Also write the rows as CSV (the columns of a sweep's critical.csv) to this file.
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// Keep every classified drop in this file (one JSON line each) and reuse the drops it
+    /// already holds of the same coefficient, speed, scene, --duration-s and build: the same
+    /// command run again after a kill runs only the missing drops, and a narrower --tol-rpm
+    /// or a wider range reuses the shared ones. The file is kept; delete it to start afresh.
+    #[arg(long, value_name = "FILE")]
+    log: Option<PathBuf>,
     /// Fidelity preset (draft, standard, reference) for the search; the onset bracket is
     /// then re-checked at the next tighter preset (recorded as `recheck`).
     #[arg(long)]
@@ -115,12 +126,37 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
         crate::check_writable(p).map_err(Failure::Output)?;
     }
 
+    let log = match &a.log {
+        None => None,
+        Some(p) => Some(DropLog::open_kept(p, a.duration_s).map_err(|e| {
+            if e.is_storage_error() {
+                Failure::Output(e.into())
+            } else {
+                Failure::Input(e.into())
+            }
+        })?),
+    };
+    if let (Some(l), Some(p)) = (&log, &a.log) {
+        errln!(
+            "drop log {}: {} drops of this --duration-s and build to reuse",
+            p.display(),
+            l.usable()
+        );
+    }
+
     let start = Instant::now();
     let label = format!("critical search, {} friction coefficient(s)", a.mu.len());
     let ticker = Ticker::new(&label, 0, !a.no_progress);
-    let rows = critical_rows_ticked(&base, &a.mu, &opts, &ticker);
+    let rows = critical_rows_logged(&base, &a.mu, &opts, &ticker, log.as_ref());
     ticker.finish();
     let mut rows = rows.map_err(|e| Failure::Input(e.into()))?;
+    if let (Some(l), Some(p)) = (log, &a.log) {
+        let reused = l.reused();
+        if let Some(warning) = l.finish() {
+            errln!("warning: {warning}");
+        }
+        errln!("drop log {}: {reused} drops reused", p.display());
+    }
     if let Some(tighter) = a.fidelity.and_then(|f| f.tighter()) {
         let drop_opts = whirlmap_core::DropOptions {
             duration_s: a.duration_s,

@@ -413,3 +413,106 @@ fn a_sweep_shard_and_merge_exit_1_when_a_critical_speed_is_undecided() {
     );
     check_rows(&merged);
 }
+
+/// `--log FILE` keeps the search's drops: a killed search run again with the same file runs
+/// only the missing drops and prints the rows of an uninterrupted run; a second run reuses
+/// every drop and appends nothing; a run at another `--duration-s` reuses none; a file that
+/// is not such a log is refused (exit 2) and left as it is.
+#[test]
+fn a_kept_drop_log_resumes_a_killed_search_and_answers_a_rerun() {
+    let dir = temp_dir("critical-log");
+    let search = |log: &std::path::Path, duration: &str| -> Vec<String> {
+        vec![
+            "critical".into(),
+            "--json".into(),
+            "--no-progress".into(),
+            "--mu".into(),
+            "0.3,0.4".into(),
+            "--from".into(),
+            "2000".into(),
+            "--to".into(),
+            "12000".into(),
+            "--resolution-rpm".into(),
+            "500".into(),
+            "--tol-rpm".into(),
+            "62.5".into(),
+            "--duration-s".into(),
+            duration.into(),
+            "--log".into(),
+            s(log).into(),
+        ]
+    };
+    let lines = |p: &std::path::Path| std::fs::read_to_string(p).unwrap().lines().count();
+
+    // Uninterrupted: every classified drop is one line.
+    let full_log = dir.join("full.jsonl");
+    let full = whirlmap(&search(&full_log, "1"));
+    assert!(full.status.success(), "{}", stderr(&full));
+    let rows: Vec<serde_json::Value> = serde_json::from_slice(&full.stdout).unwrap();
+    let drops: u64 = rows.iter().map(|r| r["drops"].as_u64().unwrap()).sum();
+    assert_eq!(lines(&full_log) as u64, drops);
+    assert!(
+        stderr(&full).contains("0 drops reused"),
+        "{}",
+        stderr(&full)
+    );
+
+    // Killed after ten drops, then run again: the same rows, the rest of the drops run.
+    let log = dir.join("killed.jsonl");
+    let held = kill_after_lines(&search(&log, "1"), &log, 10);
+    assert!((held as u64) < drops, "{held} of {drops}");
+    let resumed = whirlmap(&search(&log, "1"));
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
+    assert!(resumed.stdout == full.stdout, "resumed rows differ");
+    assert!(
+        stderr(&resumed).contains(&format!("{held} drops reused")),
+        "{held}: {}",
+        stderr(&resumed)
+    );
+    assert_eq!(lines(&log) as u64, drops);
+
+    // Run again: every drop from the log, nothing appended.
+    let before = std::fs::read(&full_log).unwrap();
+    let again = whirlmap(&search(&full_log, "1"));
+    assert!(again.stdout == full.stdout);
+    assert!(stderr(&again).contains(&format!("{drops} drops reused")));
+    assert_eq!(std::fs::read(&full_log).unwrap(), before);
+
+    // The rows come from the log: a class changed in it changes them.
+    let text = String::from_utf8(before.clone()).unwrap();
+    let marked = text.replacen("\"class\":\"pendulum\"", "\"class\":\"backward_whirl\"", 1);
+    assert_ne!(marked, text, "the search has a pendulum drop");
+    let marked_log = dir.join("marked.jsonl");
+    std::fs::write(&marked_log, marked).unwrap();
+    let fooled = whirlmap(&search(&marked_log, "1"));
+    assert!(fooled.status.success(), "{}", stderr(&fooled));
+    assert!(fooled.stdout != full.stdout, "the marked line was not used");
+
+    // Another drop length: nothing to reuse.
+    let other = whirlmap(&search(&full_log, "0.5"));
+    assert!(other.status.success(), "{}", stderr(&other));
+    assert!(
+        stderr(&other).contains("0 drops of this --duration-s and build to reuse"),
+        "{}",
+        stderr(&other)
+    );
+
+    // Not a drop log: refused before any drop, the file untouched.
+    let csv = dir.join("notes.csv");
+    std::fs::write(&csv, "speed,class\n6000,whirl\n").unwrap();
+    let refused = whirlmap(&search(&csv, "1"));
+    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+    assert!(
+        stderr(&refused).contains("is not a critical-search drop log (line 1"),
+        "{}",
+        stderr(&refused)
+    );
+    assert_eq!(
+        std::fs::read_to_string(&csv).unwrap(),
+        "speed,class\n6000,whirl\n"
+    );
+    // A directory is a bad path (exit 2), not a failed disk.
+    let refused = whirlmap(&search(&dir, "1"));
+    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+    let _ = std::fs::remove_dir_all(&dir);
+}

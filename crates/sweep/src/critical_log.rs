@@ -10,6 +10,12 @@
 //! log is removed once `critical.json` is written. A resume reuses a line only for the same
 //! coefficient, speed and scene hash (the sweep's `--resume` has already checked the spec and
 //! the build); lines it cannot read are dropped, and their drops run again.
+//!
+//! `whirlmap critical --log FILE` keeps such a log of its own across runs
+//! ([`DropLog::open_kept`]): its lines also carry the drop length and the build, and a line
+//! answers a drop only for the same coefficient, speed, scene, length and build. A killed
+//! search run again resumes, and a rerun with a narrower tolerance or a wider range reuses
+//! the drops the two share.
 
 use crate::extras::ExtrasError;
 use serde::{Deserialize, Serialize};
@@ -19,16 +25,86 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
+use thiserror::Error;
 use whirlmap_core::OrbitClass;
 use whirlmap_results::files::CRITICAL_DROPS_FILE;
 
 /// One logged drop.
 #[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 struct Line {
     mu: f64,
     speed_rpm: f64,
     scene_hash: String,
     class: OrbitClass,
+    /// The drop length (s): in a kept log only (a sweep's spec fixes it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    duration_s: Option<f64>,
+    /// The build, `version (commit c)`: in a kept log only (a sweep's resume checks it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    build: Option<String>,
+}
+
+/// What a drop is looked up by: the coefficient's and the speed's bits, the scene hash, and
+/// in a kept log the drop length's bits and the build.
+type Key = (u64, u64, String, Option<u64>, Option<String>);
+
+/// Why a kept log ([`DropLog::open_kept`]) cannot be used.
+#[derive(Debug, Error)]
+pub enum KeptLogError {
+    /// The file exists but holds something else: it is left as it is.
+    #[error(
+        "{path} is not a critical-search drop log (line {line}: {reason}); it is left as it \
+         is: name another --log file"
+    )]
+    NotALog {
+        /// The file.
+        path: PathBuf,
+        /// The first line that is not a logged drop (1-based).
+        line: usize,
+        /// Why it is not.
+        reason: String,
+    },
+    /// Another process holds the file's lock.
+    #[error(
+        "{path} is in use by another whirlmap critical; wait for it, or name another --log file"
+    )]
+    Busy {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The file cannot be opened, read, locked or trimmed.
+    #[error("cannot use {path} as the drop log")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+}
+
+impl KeptLogError {
+    /// Whether the storage failed (exit 4: disk full, an I/O error) rather than the file
+    /// named being unusable (exit 2: another kind of file, a directory, no permission, in
+    /// use), as [`crate::folder::is_storage_error`] tells them apart.
+    pub fn is_storage_error(&self) -> bool {
+        match self {
+            KeptLogError::Io { source, .. } => crate::folder::is_storage_error(source),
+            _ => false,
+        }
+    }
+}
+
+impl Line {
+    fn key(self) -> Key {
+        (
+            self.mu.to_bits(),
+            self.speed_rpm.to_bits(),
+            self.scene_hash,
+            self.duration_s.map(f64::to_bits),
+            self.build,
+        )
+    }
 }
 
 /// The log of one critical search in a results folder: what an earlier, killed run of the same
@@ -37,8 +113,10 @@ struct Line {
 pub struct DropLog {
     path: PathBuf,
     file: Mutex<File>,
-    /// (mu bits, speed bits, scene hash) -> class, from the earlier run.
-    known: HashMap<(u64, u64, String), OrbitClass>,
+    /// The lines' keys -> class, from the earlier runs.
+    known: HashMap<Key, OrbitClass>,
+    /// What this run's lines carry beside the drop: `(duration_s, build)` in a kept log.
+    context: Option<(f64, String)>,
     /// Drops answered from `known`.
     reused: AtomicUsize,
     /// The first failed append: the search goes on, and [`DropLog::finish`] reports it.
@@ -68,10 +146,8 @@ impl DropLog {
             let whole = &bytes[..whirlmap_results::read::complete_len(&bytes)];
             for line in whole.split_inclusive(|b| *b == b'\n') {
                 if let Ok(l) = serde_json::from_slice::<Line>(line) {
-                    known.insert(
-                        (l.mu.to_bits(), l.speed_rpm.to_bits(), l.scene_hash),
-                        l.class,
-                    );
+                    let class = l.class;
+                    known.insert(l.key(), class);
                     kept.extend_from_slice(line);
                 }
             }
@@ -92,14 +168,92 @@ impl DropLog {
             path,
             file: Mutex::new(file),
             known,
+            context: None,
             reused: AtomicUsize::new(0),
             error: Mutex::new(None),
         })
     }
 
+    /// Opens (or creates) the log a user names, kept across runs: every line it holds is
+    /// read, and those of drops `duration_s` long made by this build answer their drops. The
+    /// file is locked while the search runs (a second search on it is refused). A torn last
+    /// line, which a kill leaves, is cut; the file is otherwise never rewritten, and a file
+    /// with any other whole line that is not a logged drop is refused and left as it is.
+    pub fn open_kept(path: &Path, duration_s: f64) -> Result<Self, KeptLogError> {
+        let io = |source| KeptLogError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .append(true)
+            .create(true)
+            .open(path)
+            .map_err(io)?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                return Err(KeptLogError::Busy {
+                    path: path.to_path_buf(),
+                })
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(io(e)),
+        }
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(&mut file, &mut bytes).map_err(io)?;
+        let whole = whirlmap_results::read::complete_len(&bytes);
+        let mut known = HashMap::new();
+        for (i, line) in bytes[..whole].split(|b| *b == b'\n').enumerate() {
+            if line.is_empty() {
+                continue;
+            }
+            let l = serde_json::from_slice::<Line>(line).map_err(|e| KeptLogError::NotALog {
+                path: path.to_path_buf(),
+                line: i + 1,
+                reason: e.to_string(),
+            })?;
+            let class = l.class;
+            known.insert(l.key(), class);
+        }
+        if whole < bytes.len() {
+            file.set_len(whole as u64).map_err(io)?;
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            file: Mutex::new(file),
+            known,
+            context: Some((duration_s, crate::build_info::DESCRIPTION.to_string())),
+            reused: AtomicUsize::new(0),
+            error: Mutex::new(None),
+        })
+    }
+
+    /// How many drops the log holds that this run can use (read when it was opened).
+    pub fn usable(&self) -> usize {
+        let (d, b) = self.context_key();
+        self.known
+            .keys()
+            .filter(|k| k.3 == d && k.4.as_deref() == b)
+            .count()
+    }
+
+    fn context_key(&self) -> (Option<u64>, Option<&str>) {
+        match &self.context {
+            Some((d, b)) => (Some(d.to_bits()), Some(b.as_str())),
+            None => (None, None),
+        }
+    }
+
     /// The class an earlier run found for this coefficient, speed and scene, if it logged it.
     pub fn known(&self, mu: f64, speed_rpm: f64, scene_hash: &str) -> Option<OrbitClass> {
-        let key = (mu.to_bits(), speed_rpm.to_bits(), scene_hash.to_string());
+        let (d, b) = self.context_key();
+        let key = (
+            mu.to_bits(),
+            speed_rpm.to_bits(),
+            scene_hash.to_string(),
+            d,
+            b.map(str::to_string),
+        );
         let class = *self.known.get(&key)?;
         self.reused.fetch_add(1, Ordering::Relaxed);
         Some(class)
@@ -112,6 +266,8 @@ impl DropLog {
             speed_rpm,
             scene_hash: scene_hash.to_string(),
             class,
+            duration_s: self.context.as_ref().map(|c| c.0),
+            build: self.context.as_ref().map(|c| c.1.clone()),
         };
         let mut text = serde_json::to_string(&line).expect("a log line serialises");
         text.push('\n');
