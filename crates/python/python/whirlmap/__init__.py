@@ -274,7 +274,7 @@ def sweep(
         holds ``index``, ``key``, ``status`` (``"ok"`` or ``"failed"``), the axis values by
         axis name, ``duration_s``, ``model_version``, ``scene_hash``, ``error_kind`` and
         ``error`` (``None`` when ok), and every field of the drop record, nested ones as
-        dotted names (``energy.residual_rel``, ``features.window.stats.contact_duty``); a
+        dotted names (``energy.residual_rel``, ``features.window.contact_duty``); a
         record field named as an axis keeps the axis value. ``pandas.DataFrame(rows)``
         reads them.
 
