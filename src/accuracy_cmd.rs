@@ -8,6 +8,9 @@ use crate::Failure;
 use anyhow::Context;
 use std::path::PathBuf;
 use whirlmap_plot::accuracy::{draw_work_precision, CostAxis, RunCost, StudyRun};
+use whirlmap_results::files::{
+    ACCURACY_CSV_FILE, ACCURACY_REPORT_FILE, STUDY_FILE, WORK_PRECISION_CHARTS,
+};
 use whirlmap_sweep::accuracy::{run, to_csv, to_markdown, AccuracySpec, AccuracySpecError, Study};
 
 /// Arguments of `whirlmap accuracy`.
@@ -51,6 +54,12 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create {}", a.out.display()))
         .map_err(Failure::Output)?;
+    let storage = |e: whirlmap_sweep::sweep::SweepError| Failure::coded(e.exit_code(), e);
+    let previous = if a.overwrite {
+        whirlmap_sweep::folder::move_owned_aside(&a.out).map_err(storage)?
+    } else {
+        None
+    };
     let pool = whirlmap_sweep::pool::pool(Some(a.threads as usize))
         .map_err(|e| Failure::Input(e.into()))?;
     let jobs = spec.cases.len()
@@ -76,21 +85,21 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
             .with_context(|| format!("cannot write {}", p.display()))
             .map_err(Failure::Output)
     };
-    write("accuracy.csv", to_csv(&study))?;
+    write(ACCURACY_CSV_FILE, to_csv(&study))?;
     let md = to_markdown(&study, &spec);
-    write("accuracy.md", md.clone())?;
+    write(ACCURACY_REPORT_FILE, md.clone())?;
     write(
         STUDY_FILE,
         serde_json::to_string_pretty(&study).expect("a study serialises"),
     )?;
     draw_charts(&a.out, &spec.name, &study)?;
+    whirlmap_sweep::folder::release_previous(previous).map_err(storage)?;
     outln!("{md}");
     errln!("written to {}", a.out.display());
     Ok(())
 }
 
 /// The study's own record, from which its charts can be drawn again.
-const STUDY_FILE: &str = "study.json";
 
 /// The `study.json` in `out`, checked to be a study of `spec`'s cases and settings (exit 2
 /// otherwise).
@@ -135,10 +144,10 @@ fn read_study(out: &std::path::Path, spec: &AccuracySpec) -> Result<Study, Failu
 /// Draws `work_precision` and `work_precision_wall` (PNG and SVG) of `study` into `out`.
 fn draw_charts(out: &std::path::Path, name: &str, study: &Study) -> Result<(), Failure> {
     let (cases, runs) = chart_runs(study);
-    for (axis, stem) in [
-        (CostAxis::RhsEvals, "work_precision"),
-        (CostAxis::WallMs, "work_precision_wall"),
-    ] {
+    for (axis, stem) in [CostAxis::RhsEvals, CostAxis::WallMs]
+        .into_iter()
+        .zip(WORK_PRECISION_CHARTS)
+    {
         for ext in ["png", "svg"] {
             let p = out.join(format!("{stem}.{ext}"));
             let title = format!("Work-precision: {name} (reference DOP853)");

@@ -71,13 +71,14 @@ fn failure(e: SweepError) -> Failure {
     Failure::coded(e.exit_code(), e)
 }
 
-/// Reads the file and takes the output folder's lock (one writer at a time; released when the
-/// returned lock is dropped, or the process ends).
-fn load(
-    a: &EnsembleArgs,
-    what: &str,
-    resume: bool,
-) -> Result<(ensemble::EnsembleSpec, PathBuf, FolderLock), Failure> {
+/// A loaded file, its output folder and the folder's lock (one writer at a time; released when
+/// dropped, or when the process ends), and with `--overwrite` the earlier run's files moved
+/// aside ([`whirlmap_sweep::folder::move_owned_aside`]).
+type Loaded = (ensemble::EnsembleSpec, PathBuf, FolderLock, Option<PathBuf>);
+
+/// Reads the file, takes the output folder's lock and, with `--overwrite`, moves whirlmap's
+/// files already there aside.
+fn load(a: &EnsembleArgs, what: &str, resume: bool) -> Result<Loaded, Failure> {
     let s = ensemble::load(&a.file).map_err(|e| Failure::coded(2, e))?;
     let out = a
         .out
@@ -111,7 +112,12 @@ fn load(
         .map_err(|e| whirlmap_sweep::folder::output_error(&out, e))
         .and_then(|_| FolderLock::acquire(&out, what))
         .map_err(failure)?;
-    Ok((s, out, lock))
+    let previous = if a.overwrite {
+        whirlmap_sweep::folder::move_owned_aside(&out).map_err(failure)?
+    } else {
+        None
+    };
+    Ok((s, out, lock, previous))
 }
 
 fn fmt_speed(v: Option<f64>) -> String {
@@ -128,7 +134,7 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
         ));
     }
     let a = &args.common;
-    let (spec, out, _lock) = load(a, "ensemble", args.resume)?;
+    let (spec, out, _lock, previous) = load(a, "ensemble", args.resume)?;
     let o = run_ensemble(
         &spec,
         &out,
@@ -183,13 +189,14 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
     let w = whirlmap_plot::probability::render_probability(&out)
         .map_err(|e| Failure::coded(4, format!("charts: {e}")))?;
     outln!("  output           {} ({} charts)", out.display(), w.len());
+    whirlmap_sweep::folder::release_previous(previous).map_err(failure)?;
     Ok(Done::flagged_if(o.failed > 0))
 }
 
 /// Runs `whirlmap adaptive`.
 pub fn run_adaptive_cmd(args: &AdaptiveArgs) -> CmdResult {
     let a = &args.common;
-    let (spec, out, _lock) = load(a, "adaptive", args.resume)?;
+    let (spec, out, _lock, previous) = load(a, "adaptive", args.resume)?;
     let (r, path) = run_adaptive(
         &spec,
         &out,
@@ -219,6 +226,7 @@ pub fn run_adaptive_cmd(args: &AdaptiveArgs) -> CmdResult {
             g.max_shift_cells, g.columns_differing, g.points_differing
         );
     }
+    whirlmap_sweep::folder::release_previous(previous).map_err(failure)?;
     outln!("  output           {}", path.display());
     Ok(Done::flagged_if(
         r.evaluated.iter().any(|c| c.p_whirl.is_nan()),

@@ -128,8 +128,12 @@ fn a_second_writer_is_refused_and_a_killed_writer_leaves_no_lock() {
     assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
     assert!(stderr(&o).contains("in use"), "{}", stderr(&o));
     assert!(manifest_names(&out, "slow"));
-    // kill -9: the operating system drops the lock, so the folder is free at once, and what
-    // it left is said to be partial.
+    // kill -9 once a record is in: the operating system drops the lock, so the folder is free
+    // at once, and what it left is said to be partial (a folder without a record has nothing
+    // to draw: `runs_of_different_kinds_never_share_a_folder`).
+    wait_until(&mut first, "the first record", || {
+        std::fs::read(out.join("points.jsonl")).is_ok_and(|b| b.contains(&b'\n'))
+    });
     first.kill().unwrap();
     first.wait().unwrap();
     let o = whirlmap(&["render", s(&out)]);
@@ -824,4 +828,68 @@ fn compare_refuses_incomparable_runs_and_states_spec_differences() {
         "{md}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// One folder, one kind of run: a sweep is refused in an ensemble's folder; an ensemble's
+/// `--overwrite` over a sweep's folder moves the sweep's files aside and deletes them once it
+/// is written (so `render` draws the ensemble's Fig. 4, not the old sweep's charts), and a
+/// sweep's `--overwrite` over an ensemble's folder does the same. `render` refuses a
+/// `points.jsonl` without a record, and draws an ensemble's folder without a warning.
+#[test]
+fn runs_of_different_kinds_never_share_a_folder() {
+    let dir = temp_dir("kinds");
+    let tiny = spec_file(&dir, "tiny", TINY);
+    let ens = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/ensemble-smoke.json");
+    let ensemble = |out: &Path, extra: &[&str]| {
+        let mut args = vec!["ensemble", s(&ens), "--out", s(out), "--no-progress"];
+        args.extend_from_slice(extra);
+        whirlmap(&args)
+    };
+
+    let e = dir.join("ensemble");
+    let o = ensemble(&e, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let o = sweep(&tiny, &e, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(stderr(&o).contains("members.jsonl"), "{}", stderr(&o));
+    assert!(!e.join("points.jsonl").exists());
+    let o = whirlmap(&["render", s(&e)]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+
+    let sw = dir.join("sweep");
+    let o = sweep(&tiny, &sw, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let o = ensemble(&sw, &["--overwrite"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    for gone in ["points.jsonl", "summary.csv", "previous-run"] {
+        assert!(
+            !sw.join(gone).exists(),
+            "{gone} is left beside the ensemble"
+        );
+    }
+    assert!(sw.join("members.jsonl").is_file());
+    let o = whirlmap(&["render", s(&sw)]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    assert!(out(&o).contains("fig4_probability"), "{}", out_text(&o));
+    assert!(!out(&o).contains("classes"), "{}", out_text(&o));
+
+    let o = sweep(&tiny, &e, &["--overwrite"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    for gone in [
+        "members.jsonl",
+        "cells.jsonl",
+        "contours.json",
+        "previous-run",
+    ] {
+        assert!(!e.join(gone).exists(), "{gone} is left beside the sweep");
+    }
+
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    std::fs::write(empty.join("points.jsonl"), "").unwrap();
+    let o = whirlmap(&["render", s(&empty)]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert!(stderr(&o).contains("no complete record"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
 }

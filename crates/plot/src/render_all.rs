@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use whirlmap_results::files::CHARTS_DIR;
 use whirlmap_results::files::{MANIFEST_FILE, POINTS_FILE};
 use whirlmap_results::grid::{assemble_grid, distinct_sorted};
+use whirlmap_results::read::LoadError;
 
 use crate::axes::CHART_SIZE;
 use crate::error::ChartError;
@@ -69,6 +70,15 @@ pub fn render_all_keeping(dir: &Path, keep: &[&str]) -> Result<Vec<PathBuf>, Cha
         return Ok(prob);
     }
     let rows = load_points(dir)?;
+    if rows.is_empty() {
+        // Nothing to draw: an empty file, or a run killed before its first record.
+        return Err(LoadError::Parse {
+            path: dir.join(POINTS_FILE),
+            line: 1,
+            message: "no sweep results: the file holds no complete record".into(),
+        }
+        .into());
+    }
     let critical = load_critical(dir)?;
     let orbits = load_orbits(dir)?;
     let grid = assemble_grid(&rows);

@@ -52,6 +52,17 @@ pub const ADAPTIVE_FILE: &str = "adaptive.json";
 /// the build, then one JSON line per corner; `--resume` reuses them); removed once
 /// [`ADAPTIVE_FILE`] is written.
 pub const ADAPTIVE_CORNERS_FILE: &str = "adaptive-corners.jsonl";
+/// An ensemble's per-cell results as a table.
+pub const CELLS_CSV_FILE: &str = "cells.csv";
+/// A work-precision study's rows (`whirlmap accuracy`).
+pub const ACCURACY_CSV_FILE: &str = "accuracy.csv";
+/// A work-precision study's report.
+pub const ACCURACY_REPORT_FILE: &str = "accuracy.md";
+/// A work-precision study's whole result (every run), which its charts are drawn from.
+pub const STUDY_FILE: &str = "study.json";
+/// The stems of a work-precision study's charts (`.png` and `.svg` each): error against RHS
+/// evaluations, and against wall time.
+pub const WORK_PRECISION_CHARTS: [&str; 2] = ["work_precision", "work_precision_wall"];
 
 /// The file name of a recorded orbit (in [`ORBITS_DIR`]): `stem.json`.
 pub fn orbit_file(stem: &str) -> String {

@@ -71,7 +71,7 @@ pub use whirlmap_results::ensemble::{percentile, CellStats, Drawn, MemberRecord,
 use whirlmap_results::manifest::{EnsembleManifest, SortedKeys};
 
 /// Per-cell statistics as CSV.
-pub const CELLS_CSV: &str = "cells.csv";
+pub const CELLS_CSV: &str = whirlmap_results::files::CELLS_CSV_FILE;
 pub use whirlmap_results::contours::{ContourGroup, ContoursFile, LevelCrossing};
 pub use whirlmap_results::files::{CELLS_FILE, CONTOURS_FILE, MANIFEST_FILE, MEMBERS_FILE};
 

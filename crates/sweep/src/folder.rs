@@ -39,16 +39,33 @@ use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use whirlmap_results::files::{
-    BEARING_REPORT_FILE, CHARTS_DIR, COMPARE_CLASSES_FILE, COMPARE_REPORT_FILE, CONTOURS_FILE,
-    CRITICAL_CSV_FILE, CRITICAL_DROPS_FILE, CRITICAL_FILE, MANIFEST_FILE, ORBITS_DIR, POINTS_FILE,
-    PROBABILITY_DIR, SHARD_FILE, SUMMARY_FILE, TIMINGS_FILE,
+    ACCURACY_CSV_FILE, ACCURACY_REPORT_FILE, ADAPTIVE_CORNERS_FILE, ADAPTIVE_FILE,
+    BEARING_REPORT_FILE, CELLS_CSV_FILE, CELLS_FILE, CHARTS_DIR, COMPARE_CLASSES_FILE,
+    COMPARE_REPORT_FILE, CONTOURS_FILE, CRITICAL_CSV_FILE, CRITICAL_DROPS_FILE, CRITICAL_FILE,
+    MANIFEST_FILE, MEMBERS_FILE, ORBITS_DIR, POINTS_FILE, PROBABILITY_DIR, SHARD_FILE, STUDY_FILE,
+    SUMMARY_FILE, TIMINGS_FILE,
 };
 use whirlmap_results::manifest::{Manifest, ShardTag};
 
 pub use whirlmap_results::files::{LOCK_FILE, PREVIOUS_DIR};
 
-/// The names whirlmap writes into a results folder (files and folders).
+/// The names whirlmap writes into a results folder (files and folders): a sweep's, and those
+/// of the other commands' folders (an ensemble's, an adaptive search's, a work-precision
+/// study's), so that no command writes into another's folder unasked.
 pub const OWNED: &[&str] = &[
+    MEMBERS_FILE,
+    CELLS_FILE,
+    CELLS_CSV_FILE,
+    CONTOURS_FILE,
+    ADAPTIVE_FILE,
+    ADAPTIVE_CORNERS_FILE,
+    ACCURACY_CSV_FILE,
+    ACCURACY_REPORT_FILE,
+    STUDY_FILE,
+    "work_precision.png",
+    "work_precision.svg",
+    "work_precision_wall.png",
+    "work_precision_wall.svg",
     POINTS_FILE,
     TIMINGS_FILE,
     SUMMARY_FILE,
@@ -416,6 +433,49 @@ impl RunFolder {
     pub fn files(&self) -> &BTreeMap<String, FileEntry> {
         &self.files
     }
+}
+
+/// `--overwrite` for the commands that write their folder whole (`ensemble`, `adaptive`,
+/// `accuracy`), with the folder's lock held: every name of [`OWNED`] in `dir` (a sweep's files,
+/// another ensemble's, a study's) is moved into [`PREVIOUS_DIR`], so that what the command
+/// writes is not mixed with another run's files, and nothing is lost if it is killed. When
+/// [`PREVIOUS_DIR`] is there already, an earlier overwrite did not finish: what it moved aside
+/// is kept, and the files of that unfinished run are removed. Returns the folder to remove
+/// ([`release_previous`]) once the command's results are written; `None` when nothing of
+/// whirlmap's was there.
+pub fn move_owned_aside(dir: &Path) -> Result<Option<PathBuf>, SweepError> {
+    let present: Vec<&str> = OWNED
+        .iter()
+        .copied()
+        .filter(|n| *n != PREVIOUS_DIR && dir.join(n).symlink_metadata().is_ok())
+        .collect();
+    let prev = dir.join(PREVIOUS_DIR);
+    if prev.symlink_metadata().is_ok() {
+        for name in &present {
+            remove_path(&dir.join(name))?;
+        }
+    } else if present.is_empty() {
+        return Ok(None);
+    } else {
+        std::fs::create_dir(&prev).map_err(io_err(&prev))?;
+        for name in &present {
+            let from = dir.join(name);
+            std::fs::rename(&from, prev.join(name)).map_err(io_err(&from))?;
+        }
+    }
+    sync_dir(dir);
+    Ok(Some(prev))
+}
+
+/// Deletes what [`move_owned_aside`] moved aside, once the new results are written.
+pub fn release_previous(prev: Option<PathBuf>) -> Result<(), SweepError> {
+    if let Some(p) = prev {
+        remove_path(&p)?;
+        if let Some(dir) = p.parent() {
+            sync_dir(dir);
+        }
+    }
+    Ok(())
 }
 
 /// Removes a file or a folder tree; absent is fine.
