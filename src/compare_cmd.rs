@@ -6,7 +6,7 @@
 
 use crate::{CmdResult, Done, Failure};
 use std::path::PathBuf;
-use whirlmap_sweep::compare::{compare, write_report, ClassMap, Thresholds};
+use whirlmap_sweep::compare::{check_report_path, compare, write_report, ClassMap, Thresholds};
 
 /// Arguments of `whirlmap compare`.
 #[derive(clap::Args)]
@@ -34,16 +34,12 @@ pub fn run(a: &CompareArgs) -> CmdResult {
         power_rel: a.power_rel,
     };
     t.validate().map_err(|e| Failure::coded(2, e))?;
+    let out = a.out.clone().unwrap_or_else(|| a.new.join("compare.md"));
+    check_report_path(&out).map_err(|e| Failure::coded(2, e))?;
     let c = compare(&a.baseline, &a.new, t).map_err(|e| Failure::coded(2, e))?;
     for w in &c.warnings {
         errln!("warning: {w}");
     }
-    let out = a.out.clone().unwrap_or_else(|| a.new.join("compare.md"));
-    let draw = |m: &ClassMap| {
-        whirlmap_plot::classes::draw_marked_class_map(m.path, m.grid, m.title, m.marked)
-            .map_err(|e| e.to_string())
-    };
-    let png = write_report(&c, &out, &draw).map_err(|e| Failure::coded(2, e))?;
     outln!(
         "compare: {}: {} of {} points and {} of {} critical speeds changed{}",
         if c.changed() { "CHANGED" } else { "same" },
@@ -69,6 +65,11 @@ pub fn run(a: &CompareArgs) -> CmdResult {
     for k in &c.critical {
         outln!("  critical speed at mu = {}: {}", k.mu, k.what);
     }
+    let draw = |m: &ClassMap| {
+        whirlmap_plot::classes::draw_marked_class_map(m.path, m.grid, m.title, m.marked)
+            .map_err(|e| e.to_string())
+    };
+    let png = write_report(&c, &out, &draw).map_err(|e| Failure::coded(2, e))?;
     outln!("  report           {}", out.display());
     outln!("  class map        {}", png.display());
     Ok(Done::flagged_if(c.changed()))

@@ -169,11 +169,7 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
         }
     }
     let wall_s = start.elapsed().as_secs_f64();
-    if let Some(p) = &a.csv {
-        std::fs::write(p, csv_text(&rows))
-            .map_err(|e| Failure::Output(anyhow::anyhow!("cannot write {}: {e}", p.display())))?;
-    }
-
+    // The rows are printed first: a CSV that cannot be written (a full disk) loses nothing.
     if a.json {
         outln!(
             "{}",
@@ -181,6 +177,10 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
         );
     } else {
         print_table(a, &rows, wall_s);
+    }
+    if let Some(p) = &a.csv {
+        std::fs::write(p, csv_text(&rows))
+            .map_err(|e| Failure::Output(anyhow::anyhow!("cannot write {}: {e}", p.display())))?;
     }
     Ok(Done::flagged_if(report_undecided(&rows)))
 }

@@ -396,6 +396,24 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
     };
     let mut scene = build_scene_with(a.scene.as_deref(), &a.set, a.speed_rpm, a.mu, on)
         .map_err(Failure::Input)?;
+    // A `--set thermal=null` (or `bearing=null`) after the flag that asks for the model.
+    if on.thermal && scene.thermal.is_none() {
+        let flag = if a.temperatures.is_some() {
+            "--temperatures"
+        } else {
+            "--thermal"
+        };
+        return Err(Failure::Input(anyhow::anyhow!(
+            "{flag} needs the thermal model, which `--set thermal=null` switches off: drop one \
+             of the two"
+        )));
+    }
+    if on.bearing && scene.bearing.is_none() {
+        return Err(Failure::Input(anyhow::anyhow!(
+            "--bearing needs the bearing analysis, which `--set bearing=null` switches off: drop \
+             one of the two"
+        )));
+    }
     if let Some(f) = a.fidelity {
         f.apply(&mut scene);
     }
@@ -415,6 +433,16 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
         .map_err(|e| Failure::Solve(anyhow::anyhow!("simulation failed ({}): {e}", e.kind())))?;
     let wall_s = start.elapsed().as_secs_f64();
     let record = DropRecord::from_report(&report);
+    // The outputs are printed before the charts are drawn: a chart that cannot be written (a
+    // full disk) loses nothing of the drop.
+    if a.json {
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&record).expect("records serialise")
+        );
+    } else {
+        print_summary(&scene, &report, &record, wall_s);
+    }
     if let (Some(path), Some(orbit)) = (&a.orbit, &report.orbit) {
         let title = format!(
             "{:.0} r/min, mu = {:.2}{}: {}",
@@ -435,13 +463,7 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
         );
         draw_temperatures(path, &title, &th.series).map_err(|e| Failure::Output(e.into()))?;
     }
-    if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&record).expect("records serialise")
-        );
-    } else {
-        print_summary(&scene, &report, &record, wall_s);
+    if !a.json {
         if let Some(p) = &a.orbit {
             outln!("  orbit chart           {}", p.display());
         }

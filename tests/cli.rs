@@ -402,3 +402,26 @@ fn accuracy_messages_appear_once_and_an_empty_case_list_is_refused() {
     assert!(!out_dir.exists(), "nothing written");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A flag that asks for a model and a `--set` that switches it off: refused (exit 2) before
+/// the drop, not a drop without the model that claims a chart it did not draw.
+#[test]
+fn a_flag_and_a_set_that_switch_a_model_both_ways_are_refused() {
+    let chart = temp_path("temperatures.png");
+    for (args, flag) in [
+        (
+            vec!["--temperatures", s(&chart), "--set", "thermal=null"],
+            "--temperatures",
+        ),
+        (vec!["--thermal", "--set", "thermal=null"], "--thermal"),
+        (vec!["--bearing", "--set", "bearing=null"], "--bearing"),
+    ] {
+        let mut all = vec!["drop", "--duration-s", "0.05"];
+        all.extend(args);
+        let o = whirlmap(&all);
+        assert_eq!(o.status.code(), Some(2), "{all:?}: {}", out(&o));
+        assert!(stderr(&o).contains(flag), "{}", stderr(&o));
+        assert!(o.stdout.is_empty(), "{all:?} ran: {}", out(&o));
+    }
+    assert!(!chart.exists());
+}

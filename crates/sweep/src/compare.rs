@@ -491,6 +491,59 @@ pub enum ReportError {
     /// The class map could not be drawn, in the drawing's words.
     #[error("{0}")]
     Draw(String),
+    /// The report or its class map would replace a folder or another run's file.
+    #[error("{0}")]
+    Refused(String),
+}
+
+/// The class map's path beside the report at `path`: `<stem>-classes.png`.
+fn class_map_path(path: &Path) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map_or("compare".into(), |s| s.to_string_lossy().into_owned());
+    path.with_file_name(format!("{stem}-classes.png"))
+}
+
+/// Refuses a report path (checked before anything is compared or written) whose report or
+/// class map would be a folder, or would replace a file a whirlmap run wrote in a results
+/// folder (`--out RUN/points.jsonl`): only the comparison's own two names may be replaced
+/// there.
+pub fn check_report_path(path: &Path) -> Result<(), ReportError> {
+    let own = [
+        whirlmap_results::files::COMPARE_REPORT_FILE,
+        whirlmap_results::files::COMPARE_CLASSES_FILE,
+    ];
+    for p in [path.to_path_buf(), class_map_path(path)] {
+        if p.is_dir() {
+            return Err(ReportError::Refused(format!(
+                "the report would replace the folder {}: give --out a file name (e.g. {})",
+                p.display(),
+                p.join(own[0]).display()
+            )));
+        }
+        let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
+        let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+        if let (Some(name), Some(dir)) = (name, dir) {
+            let theirs =
+                crate::folder::OWNED.contains(&name.as_str()) && !own.contains(&name.as_str());
+            let results = [
+                whirlmap_results::files::MANIFEST_FILE,
+                whirlmap_results::files::POINTS_FILE,
+            ]
+            .iter()
+            .any(|f| dir.join(f).exists());
+            if theirs && results {
+                return Err(ReportError::Refused(format!(
+                    "the report would replace {}, a file of the results folder {}: name another \
+                     report (e.g. {})",
+                    p.display(),
+                    dir.display(),
+                    dir.join(own[0]).display()
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes the Markdown report to `path` and, with `draw_class_map`, the class map of the new
@@ -508,10 +561,8 @@ pub fn write_report(
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(write_err(dir))?;
     }
-    let stem = path
-        .file_stem()
-        .map_or("compare".into(), |s| s.to_string_lossy().into_owned());
-    let png = path.with_file_name(format!("{stem}-classes.png"));
+    check_report_path(path)?;
+    let png = class_map_path(path);
     let grid = assemble_grid(&c.new_rows);
     let mut marked = Vec::new();
     for (j, _) in grid.mus.iter().enumerate() {
