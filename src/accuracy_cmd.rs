@@ -99,8 +99,6 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The study's own record, from which its charts can be drawn again.
-
 /// The `study.json` in `out`, checked to be a study of `spec`'s cases and settings (exit 2
 /// otherwise).
 fn read_study(out: &std::path::Path, spec: &AccuracySpec) -> Result<Study, Failure> {
