@@ -39,18 +39,29 @@ fn compare_exit_codes_thresholds_and_report() {
     // A report that would replace a run's own file, or a folder: refused (exit 2) before
     // anything is written, the run's file untouched.
     let points = std::fs::read(base.join("points.jsonl")).unwrap();
-    for bad in [base.join("points.jsonl"), base.join("summary.csv"), dir.clone()] {
+    for bad in [
+        base.join("points.jsonl"),
+        base.join("summary.csv"),
+        dir.clone(),
+    ] {
         let o = whirlmap(&["compare", s(&base), s(&again), "--out", s(&bad)]);
         assert_eq!(o.status.code(), Some(2), "{}", out(&o));
-        assert!(stderr(&o).contains("the report would replace"), "{}", out(&o));
+        assert!(
+            stderr(&o).contains("the report would replace"),
+            "{}",
+            out(&o)
+        );
     }
     assert!(std::fs::read(base.join("points.jsonl")).unwrap() == points);
     assert!(!base.join("points-classes.png").exists());
-    assert!(!dir.parent().unwrap().join(format!(
-        "{}-classes.png",
-        dir.file_name().unwrap().to_string_lossy()
-    ))
-    .exists());
+    assert!(!dir
+        .parent()
+        .unwrap()
+        .join(format!(
+            "{}-classes.png",
+            dir.file_name().unwrap().to_string_lossy()
+        ))
+        .exists());
 
     // A tighter solver tolerance moves forces and power by tiny amounts: the same at the
     // default 5 % thresholds, changed at zero thresholds.

@@ -206,6 +206,30 @@ impl AccuracySpec {
                 )?;
             }
         }
+        // A setting's tolerance and step budget are the ladder's and the study's: one in its
+        // scene would be silently replaced.
+        for (j, st) in self.settings.iter().enumerate() {
+            for (key, by) in [
+                ("rtol", format!("settings[{j}].rtol")),
+                (
+                    "max_step_attempts",
+                    "the study's max_step_attempts".to_string(),
+                ),
+            ] {
+                let nested = st
+                    .scene
+                    .get("solver")
+                    .and_then(|v| v.as_object())
+                    .and_then(|o| o.get(key));
+                if let Some(v) = st.scene.get(&format!("solver.{key}")).or(nested) {
+                    return Err(AccuracySpecError::Range {
+                        field: format!("settings[{j}].scene.solver.{key}"),
+                        value: v.to_string(),
+                        allowed: format!("no value here: {by} sets it"),
+                    });
+                }
+            }
+        }
         if self.cases.is_empty() {
             return Err(AccuracySpecError::Range {
                 field: "cases".into(),
@@ -228,8 +252,21 @@ impl AccuracySpec {
                     "(0, 3600] s",
                 )?;
             }
-            for j in 0..self.settings.len() {
-                self.setting_scene(&s, j)?;
+            // Every ladder run's scene as it will run, so that no run fails on its input.
+            for (j, st) in self.settings.iter().enumerate() {
+                for &rtol in st.rtol.as_ref().unwrap_or(&self.rtol) {
+                    self.ladder_scene(&s, j, rtol)?.validate().map_err(|e| {
+                        AccuracySpecError::Range {
+                            field: if e.field == "solver.max_step_attempts" {
+                                "max_step_attempts".into()
+                            } else {
+                                format!("settings[{j}].scene.{} (case {})", e.field, c.name)
+                            },
+                            value: e.value,
+                            allowed: e.allowed,
+                        }
+                    })?;
+                }
             }
         }
         Ok(())
@@ -253,6 +290,20 @@ impl AccuracySpec {
             &self.cases[i].scene,
             &format!("cases[{i}].scene"),
         )
+    }
+
+    /// The scene of one ladder run: `base` (a case's scene) with setting `j`, at `rtol` and
+    /// the study's step budget.
+    pub fn ladder_scene(
+        &self,
+        base: &Scene,
+        j: usize,
+        rtol: f64,
+    ) -> Result<Scene, AccuracySpecError> {
+        let mut s = self.setting_scene(base, j)?;
+        s.solver.rtol = rtol;
+        s.solver.max_step_attempts = self.max_step_attempts;
+        Ok(s)
     }
 
     /// `base` with setting `j` applied.
@@ -502,11 +553,8 @@ pub fn run(spec: &AccuracySpec) -> Result<Study, AccuracySpecError> {
         let base = spec.case_scene(i)?;
         let d = c.duration_s.unwrap_or(spec.duration_s);
         for (j, st) in spec.settings.iter().enumerate() {
-            let s = spec.setting_scene(&base, j)?;
             for &rtol in st.rtol.as_ref().unwrap_or(&spec.rtol) {
-                let mut s = s.clone();
-                s.solver.rtol = rtol;
-                s.solver.max_step_attempts = spec.max_step_attempts;
+                let s = spec.ladder_scene(&base, j, rtol)?;
                 jobs.push((i, st.name.clone(), s, d, st.record_orbit));
             }
         }
@@ -779,5 +827,31 @@ mod tests {
             spec.validate().unwrap_err().to_string(),
             "cases = []: allowed at least one case"
         );
+    }
+
+    #[test]
+    fn every_ladder_scene_is_checked_before_a_run() {
+        let spec = |setting: &str, top: &str| -> AccuracySpec {
+            serde_json::from_str(&format!(
+                r#"{{"rtol": [1e-4], {top} "cases": [{{"name": "a", "scene": {{}}}}],
+                    "settings": [{{"name": "x", "scene": {setting}}}]}}"#
+            ))
+            .unwrap()
+        };
+        let err = |setting: &str, top: &str| spec(setting, top).validate().unwrap_err().to_string();
+        let e = err(r#"{"clearance_m": -1}"#, "");
+        assert!(
+            e.starts_with("settings[0].scene.clearance_m (case a) = -1"),
+            "{e}"
+        );
+        let e = err("{}", r#""max_step_attempts": 0,"#);
+        assert!(e.starts_with("max_step_attempts = 0"), "{e}");
+        for s in [r#"{"solver.rtol": 5}"#, r#"{"solver": {"rtol": 1e-6}}"#] {
+            let e = err(s, "");
+            assert!(e.starts_with("settings[0].scene.solver.rtol"), "{e}");
+        }
+        assert!(spec(r#"{"solver.method": "dopri5"}"#, "")
+            .validate()
+            .is_ok());
     }
 }
