@@ -160,7 +160,7 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Critical backward-whirl speed per friction coefficient (scan, then bisection).
     Critical(critical_cmd::CriticalArgs),
-    /// Run a grid of drops from a JSON sweep spec (exit 1 if any point failed).
+    /// Run a grid of drops from a JSON sweep spec (exit 1 if any point or orbit drop failed).
     Sweep(sweep_cmd::SweepArgs),
     /// Work-precision study: representative drops at a ladder of tolerances and model
     /// settings against a DOP853 reference (CSV, Markdown, log-log charts).

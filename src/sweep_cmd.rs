@@ -1,7 +1,7 @@
 //! `whirlmap sweep FILE`: run a grid of drops from a JSON sweep spec.
 //!
-//! Exit codes: 0 every point ok; 1 some point failed, or failed drops left a critical speed
-//! undecided (records and every critical row still written); 2 bad spec, an
+//! Exit codes: 0 every point ok; 1 some point or orbit drop failed, or failed drops left a
+//! critical speed undecided (records and every critical row still written); 2 bad spec, an
 //! unusable output folder, or one that is in use or holds another run's results (nothing
 //! run); 4 an output (records or charts) could not be written, a full disk included.
 
@@ -140,8 +140,19 @@ pub fn run(a: &SweepArgs) -> CmdResult {
         Some(p) => critical_line(&opts.out_dir, p),
         None => false,
     };
-    if !x.orbits.is_empty() {
-        outln!("  orbits           {} drops recorded", x.orbits.len());
+    // A panel whose drop failed has an `.error.txt` in orbits/ instead of its orbit.
+    let panels = whirlmap_sweep::extras::orbit_panels(&spec).map_or(0, |(_, mus)| mus.len());
+    let failed_orbits = panels.saturating_sub(x.orbits.len());
+    if panels > 0 {
+        outln!(
+            "  orbits           {} drops recorded{}",
+            x.orbits.len(),
+            if failed_orbits > 0 {
+                format!(", {failed_orbits} failed (orbits/*.error.txt say why)")
+            } else {
+                String::new()
+            }
+        );
     }
     if let Some(p) = &x.probability {
         outln!("  probability      {}", p.display());
@@ -149,5 +160,7 @@ pub fn run(a: &SweepArgs) -> CmdResult {
     if let Some(written) = &done.charts {
         outln!("  charts           {} files", written.len());
     }
-    Ok(Done::flagged_if(done.outcome.failed > 0 || undecided))
+    Ok(Done::flagged_if(
+        done.outcome.failed > 0 || undecided || failed_orbits > 0,
+    ))
 }

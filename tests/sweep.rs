@@ -321,6 +321,49 @@ fn a_failed_point_is_recorded_and_the_sweep_goes_on() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// An orbit panel whose drop fails (its scene's step budget, which the grid's axis raises for
+/// the grid's points) leaves its `.error.txt`, and the sweep says so and exits 1; a panel whose
+/// scene is invalid (a stop speed above the panel's speed) is refused before anything runs.
+#[test]
+fn a_failed_orbit_panel_exits_1_and_an_invalid_one_is_refused() {
+    let dir = temp_dir("orbit-failed");
+    let spec = spec_file(
+        &dir,
+        "orbits",
+        r#"{"name": "orbits", "scene": {"solver": {"max_step_attempts": 20}}, "duration_s": 0.05,
+            "axes": {"speed_rpm": [4000], "mu": [0.1], "solver.max_step_attempts": [1000000]},
+            "orbits": {"speed_rpm": 4000, "mu": [0.1, 0.2]}}"#,
+    );
+    let out = dir.join("out");
+    let o = whirlmap(&["sweep", s(&spec), "--out", s(&out), "--no-progress"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("0 drops recorded, 2 failed"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    let e = std::fs::read_to_string(out.join("orbits/00_4000rpm_mu0.100.error.txt")).unwrap();
+    assert!(e.contains("step budget"), "{e}");
+
+    let spec = spec_file(
+        &dir,
+        "invalid",
+        r#"{"name": "invalid", "scene": {"stop_speed_rpm": 1500}, "duration_s": 0.05,
+            "axes": {"speed_rpm": [4000], "mu": [0.1]},
+            "orbits": {"speed_rpm": 1000, "mu": [0.1]}}"#,
+    );
+    let out = dir.join("invalid-out");
+    let o = whirlmap(&["sweep", s(&spec), "--out", s(&out), "--no-progress"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("scene.stop_speed_rpm (the orbit panel at 1000 r/min, mu 0.1) = 1500"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.join("points.jsonl").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Points of very different cost, interleaved along the grid: in every row of four, the
 /// first drop (rtol 1e-10) takes some 30 times as long as the other three. With more than one
 /// thread the cheap points finish before the dear one before them.

@@ -752,6 +752,25 @@ impl SweepSpec {
                 });
             }
         }
+        // Each orbit panel's scene (the `orbits` section's, or the default panels the
+        // `orbits` chart asks for), as the drop will run it.
+        if let Some((speed, mus)) = crate::extras::orbit_panels(self) {
+            for mu in mus {
+                let mut s = self.base_scene();
+                s.speed_rpm = speed;
+                s.mu_dynamic = mu;
+                s.validate().map_err(|e| SpecError::Invalid {
+                    field: format!(
+                        "scene.{} (the orbit panel at {} r/min, mu {})",
+                        e.field,
+                        num(speed),
+                        num(mu)
+                    ),
+                    value: e.value,
+                    allowed: e.allowed,
+                })?;
+            }
+        }
         if let Some(e) = self.probability_spec() {
             // Grid, draws and every cell with the widest draws.
             e.cells().map_err(|err| match err {
