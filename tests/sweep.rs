@@ -321,6 +321,49 @@ fn a_failed_point_is_recorded_and_the_sweep_goes_on() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A resume keeps a record only where it holds its grid point's inputs: a record whose inputs
+/// were edited is run again (with a warning), and the file comes back as an uninterrupted run
+/// writes it.
+#[test]
+fn a_resume_runs_again_a_record_whose_inputs_were_edited() {
+    let dir = temp_dir("edited");
+    let out = dir.join("out");
+    let spec = smoke_spec();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["sweep", s(&spec), "--out", s(&out), "--no-progress"];
+        args.extend_from_slice(extra);
+        whirlmap(&args)
+    };
+    let o = run(&[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let path = out.join("points.jsonl");
+    let original = std::fs::read_to_string(&path).unwrap();
+    let first = original.lines().next().unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(first).unwrap();
+    let speed = v["inputs"]["speed_rpm"].clone();
+    v["inputs"]["speed_rpm"] = serde_json::json!(123.0);
+    let edited = original.replacen(first, &v.to_string(), 1);
+    assert_ne!(edited, original);
+    std::fs::write(&path, edited).unwrap();
+    let o = run(&["--resume"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("the records at grid index 0 do not hold their points' inputs"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("(3 resumed)"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    assert!(
+        std::fs::read_to_string(&path).unwrap() == original,
+        "{speed}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// An orbit panel whose drop fails (its scene's step budget, which the grid's axis raises for
 /// the grid's points) leaves its `.error.txt`, and the sweep says so and exits 1; a panel whose
 /// scene is invalid (a stop speed above the panel's speed) is refused before anything runs.

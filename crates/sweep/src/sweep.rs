@@ -306,6 +306,18 @@ struct Existing {
     index: Option<u64>,
     ok: bool,
     line: String,
+    /// The line's `inputs`, as written.
+    inputs: std::collections::BTreeMap<String, serde_json::Value>,
+}
+
+impl Existing {
+    /// Whether the line holds `p`'s inputs: axis name -> value, the same names and values.
+    fn holds_inputs_of(&self, p: &Point) -> bool {
+        self.inputs.len() == p.inputs.len()
+            && p.inputs
+                .iter()
+                .all(|(k, v)| self.inputs.get(k).and_then(|x| x.as_f64()) == Some(*v))
+    }
 }
 
 /// Reads `path`, drops a torn last line (truncating the file back to the last complete
@@ -340,6 +352,7 @@ fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
                 index: p.index,
                 ok: p.is_ok(),
                 line: text.to_string(),
+                inputs: p.inputs.clone(),
             },
         );
     }
@@ -700,6 +713,8 @@ impl OrderedSink<GridJob> for GridWriter<'_> {
                         index: Some(r.index as u64),
                         ok: r.status == Status::Ok,
                         line,
+                        // This run's own record: its inputs are the point's.
+                        inputs: Default::default(),
                     },
                 );
             }
@@ -756,19 +771,34 @@ pub fn run_grid(
         HashMap::new()
     };
     let total = owned_indices(grid.len(), shard).count();
-    // A record counts for a point only at the point's own grid index.
+    // A record counts for a point only at the point's own grid index, with its inputs.
     let done = |p: &Point, key: &str, existing: &HashMap<String, Existing>| {
         existing
             .get(key)
-            .is_some_and(|e| e.ok && e.index == Some(p.index as u64))
+            .is_some_and(|e| e.ok && e.index == Some(p.index as u64) && e.holds_inputs_of(p))
     };
     let mut skipped = 0;
     if resume {
+        let mut altered = Vec::new();
         for index in owned_indices(grid.len(), shard) {
             let p = grid.point(index)?;
-            if done(&p, &point_key(&p.scene, spec.duration_s), &existing) {
+            let key = point_key(&p.scene, spec.duration_s);
+            if done(&p, &key, &existing) {
                 skipped += 1;
+            } else if existing
+                .get(&key)
+                .is_some_and(|e| e.ok && !e.holds_inputs_of(&p))
+            {
+                altered.push(index.to_string());
             }
+        }
+        if !altered.is_empty() {
+            progress_line(&format!(
+                "warning: {}: the records at grid index {} do not hold their points' inputs \
+                 (edited?): those points run again",
+                points_path.display(),
+                altered.join(", ")
+            ));
         }
     }
 
