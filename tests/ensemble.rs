@@ -146,6 +146,23 @@ fn bad_ensemble_files_exit_2_and_name_the_field() {
         }
         assert!(!out.join("members.jsonl").exists(), "nothing runs");
     }
+    // No speed axis: nothing for the contours to cross along; refused before any drop.
+    let f = dir.join("nospeed.json");
+    std::fs::write(
+        &f,
+        r#"{"name": "nospeed", "duration_s": 0.05, "axes": {"mu": [0.3]},
+            "ensemble": {"members": 2, "seed": 1}}"#,
+    )
+    .unwrap();
+    let out = dir.join("nospeed");
+    let o = whirlmap(&["ensemble", s(&f), "--out", s(&out)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("axes = mu: allowed a speed_rpm axis"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists(), "nothing runs");
     // No ensemble section: `ensemble` refuses.
     let f = dir.join("none.json");
     std::fs::write(&f, format!("{{{base}}}")).unwrap();

@@ -426,6 +426,17 @@ impl EnsembleSpec {
     /// Checks the grid, the ensemble section (if any) against every cell, and the adaptive
     /// section (if any); returns the cells.
     pub fn cells(&self) -> Result<Vec<Cell>, SpecError> {
+        // The contours are speeds at which P(whirl) crosses each level: along a speed axis.
+        if !self.axes.0.iter().any(|a| a.name == "speed_rpm") {
+            let names: Vec<&str> = self.axes.0.iter().map(|a| a.name.as_str()).collect();
+            return Err(SpecError::Invalid {
+                field: "axes".into(),
+                value: names.join(", "),
+                allowed: "a speed_rpm axis among them: the probability contours are release \
+                          speeds"
+                    .into(),
+            });
+        }
         let points = self.sweep_spec().points()?;
         if let Some(e) = &self.ensemble {
             e.validate()?;
