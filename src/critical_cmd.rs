@@ -115,12 +115,20 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
     if let Some(f) = a.fidelity {
         f.apply(&mut base);
     }
-    // Each mu must make a valid scene (e.g. mu_static >= mu_dynamic) before anything runs.
+    // Each mu must make a valid scene (e.g. mu_static >= mu_dynamic) before anything runs,
+    // at the lowest speed searched too (a stop speed must lie below every release speed).
     for &mu in &a.mu {
         let mut s = base.clone();
         s.mu_dynamic = mu;
         s.validate()
             .map_err(|e| Failure::Input(anyhow::anyhow!("with --mu {mu}: {e}")))?;
+        s.speed_rpm = a.from;
+        s.validate().map_err(|e| {
+            Failure::Input(anyhow::anyhow!(
+                "with --mu {mu} at the lowest speed searched, --from {} r/min: {e}",
+                fmt_rpm(a.from)
+            ))
+        })?;
     }
     if let Some(p) = &a.csv {
         crate::check_writable(p).map_err(Failure::Output)?;

@@ -41,6 +41,13 @@ fn bad_specs_exit_2_name_the_field_and_run_nothing() {
             &["axes.mu", "empty"],
         ),
         (
+            "a stop speed above the critical search's lowest speed",
+            format!(
+                "{{{base}, \"scene\": {{\"stop_speed_rpm\": 1500}}, \"critical\": {{\"mu\": [0.3], \"speed_rpm\": {{\"from\": 1000, \"to\": 2000}}}}}}"
+            ),
+            &["scene.stop_speed_rpm (the critical search at mu 0.3, speed_rpm.from 1000 r/min) = 1500"],
+        ),
+        (
             "zero steps",
             r#"{"name": "bad", "duration_s": 0.05, "axes": {"mu": {"from": 0.1, "to": 0.3, "steps": 0}}}"#.into(),
             &["axes.mu.steps = 0"],

@@ -711,6 +711,23 @@ impl SweepSpec {
                 allowed: e.allowed,
             };
             crate::critical::check_mus(&mus).map_err(|e| invalid(e, "mu"))?;
+            // Each coefficient's scene at the lowest speed searched (a stop speed must lie
+            // below every release speed of the search).
+            for &mu in &mus {
+                let mut s = self.base_scene();
+                s.mu_dynamic = mu;
+                s.speed_rpm = c.speed_rpm.from;
+                s.validate().map_err(|e| SpecError::Invalid {
+                    field: format!(
+                        "scene.{} (the critical search at mu {}, speed_rpm.from {} r/min)",
+                        e.field,
+                        num(mu),
+                        num(c.speed_rpm.from)
+                    ),
+                    value: e.value,
+                    allowed: e.allowed,
+                })?;
+            }
             crate::critical::check_range(
                 c.speed_rpm.from,
                 c.speed_rpm.to,
