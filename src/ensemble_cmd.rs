@@ -26,7 +26,7 @@ pub struct EnsembleArgs {
     #[arg(long)]
     overwrite: bool,
     /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::MAX_THREADS as i64))]
     threads: Option<u32>,
     /// No progress lines.
     #[arg(long)]

@@ -602,9 +602,31 @@ fn main() -> ExitCode {
     ExitCode::from(output::finish(run()))
 }
 
+/// The most worker threads any command takes (`--threads`'s range).
+const MAX_THREADS: usize = 4096;
+
+/// Refuses a `RAYON_NUM_THREADS` above [`MAX_THREADS`], which the commands without
+/// `--threads` would otherwise start (rayon reads it; 99 999 threads ran out of memory before
+/// any work). Values rayon ignores (not a number) and 0 (one per core) pass.
+fn check_thread_env() -> Result<(), Failure> {
+    let Ok(text) = std::env::var("RAYON_NUM_THREADS") else {
+        return Ok(());
+    };
+    match text.trim().parse::<usize>() {
+        Ok(n) if n > MAX_THREADS => Err(Failure::Input(anyhow::anyhow!(
+            "RAYON_NUM_THREADS = {n}: allowed [1, {MAX_THREADS}] (0 or unset: one per core)"
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// Runs the command; returns its exit code.
 fn run() -> u8 {
     let cli = Cli::parse();
+    if let Err(f) = check_thread_env() {
+        errln!("error: {:#}", f.error());
+        return f.code();
+    }
     let result: CmdResult = match &cli.command {
         Command::Drop(a) => run_drop(a).map(|()| Done::Clean),
         Command::Scene(a) => {

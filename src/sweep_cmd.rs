@@ -28,7 +28,7 @@ pub struct SweepArgs {
     #[arg(long)]
     pub(crate) out: Option<PathBuf>,
     /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::MAX_THREADS as i64))]
     pub(crate) threads: Option<u32>,
     /// Continue the run in the output folder: keep its ok points, its finished critical
     /// search, orbits and probability members, and run only the rest. Only a run of the same

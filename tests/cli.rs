@@ -425,3 +425,17 @@ fn a_flag_and_a_set_that_switch_a_model_both_ways_are_refused() {
     }
     assert!(!chart.exists());
 }
+
+/// `RAYON_NUM_THREADS` beyond the `--threads` range is refused (exit 2) before any work: the
+/// commands without `--threads` would start that many threads.
+#[test]
+fn a_thread_count_from_the_environment_beyond_the_range_is_refused() {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_whirlmap"))
+        .args(["drop", "--duration-s", "0.01"])
+        .env("RAYON_NUM_THREADS", "99999")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", out(&o));
+    assert!(stderr(&o).contains("RAYON_NUM_THREADS = 99999: allowed [1, 4096]"));
+    assert!(o.stdout.is_empty());
+}

@@ -163,6 +163,22 @@ fn bad_ensemble_files_exit_2_and_name_the_field() {
         stderr(&o)
     );
     assert!(!out.exists(), "nothing runs");
+    // More drops than a sweep may have grid points: refused at once, nothing built.
+    let f = dir.join("huge.json");
+    std::fs::write(
+        &f,
+        r#"{"name": "huge", "duration_s": 0.05,
+            "axes": {"speed_rpm": {"from": 1000, "to": 30000, "steps": 1000}, "mu": [0.3, 0.4]},
+            "ensemble": {"members": 100000, "seed": 1}}"#,
+    )
+    .unwrap();
+    let o = whirlmap(&["ensemble", s(&f), "--out", s(&dir.join("huge"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("ensemble.members = 100000 members x 2000 cells = 200000000 drops"),
+        "{}",
+        stderr(&o)
+    );
     // No ensemble section: `ensemble` refuses.
     let f = dir.join("none.json");
     std::fs::write(&f, format!("{{{base}}}")).unwrap();

@@ -72,6 +72,10 @@ use whirlmap_results::manifest::{EnsembleManifest, SortedKeys};
 
 /// Per-cell statistics as CSV.
 pub const CELLS_CSV: &str = whirlmap_results::files::CELLS_CSV_FILE;
+
+/// The most cells an ensemble (or an adaptive map's fine grid) may have: every cell is held
+/// in memory with its scene while it runs (1e6 cells took 1.7 GB).
+pub const MAX_CELLS: usize = 1_000_000;
 pub use whirlmap_results::contours::{ContourGroup, ContoursFile, LevelCrossing};
 pub use whirlmap_results::files::{CELLS_FILE, CONTOURS_FILE, MANIFEST_FILE, MEMBERS_FILE};
 
@@ -436,6 +440,28 @@ impl EnsembleSpec {
                           speeds"
                     .into(),
             });
+        }
+        // The cells are held in memory (about 2 kB each): counted before they are built.
+        let n = self.sweep_spec().grid()?.len();
+        if n > MAX_CELLS {
+            return Err(SpecError::Invalid {
+                field: "axes".into(),
+                value: format!("{n} cells"),
+                allowed: format!("at most {MAX_CELLS} cells (an ensemble holds every cell)"),
+            });
+        }
+        if let Some(e) = &self.ensemble {
+            let drops = n.saturating_mul(e.members);
+            if drops > crate::spec::MAX_POINTS {
+                return Err(SpecError::Invalid {
+                    field: "ensemble.members".into(),
+                    value: format!("{} members x {n} cells = {drops} drops", e.members),
+                    allowed: format!(
+                        "at most {} drops, as a sweep's grid points (fewer members or cells)",
+                        crate::spec::MAX_POINTS
+                    ),
+                });
+            }
         }
         let points = self.sweep_spec().points()?;
         if let Some(e) = &self.ensemble {
