@@ -73,15 +73,23 @@ pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, serde_
     Ok(parsed)
 }
 
-/// serde's error with the field's path in front of it; a syntax error, one at the top level
-/// or an unknown top-level key (serde names it) as it is.
+/// serde's error with the field's path in front of it; one at the top level, an unknown
+/// top-level key (serde names it) or the end of the input as it is. A syntax error inside a
+/// field is named too (`` `clearance_m`: number out of range ``); inside a field, serde_json's
+/// "trailing characters" means a list longer than the field's fixed length, and says so.
 fn with_path(e: serde_path_to_error::Error<serde_json::Error>) -> serde_json::Error {
     let path = e.path().to_string();
     let inner = e.into_inner();
     // serde names an unknown key itself; only a nested one needs its parents.
     let says_itself = !path.contains('.') && inner.to_string().starts_with("unknown field");
-    if path == "." || says_itself || inner.is_syntax() || inner.is_eof() {
+    // A syntax error between keys (a missing comma) has no field yet: its path ends in `?`.
+    let between_keys = inner.is_syntax() && path.split('.').any(|p| p == "?");
+    if path == "." || path.is_empty() || says_itself || inner.is_eof() || between_keys {
         inner
+    } else if inner.is_syntax() && inner.to_string().starts_with("trailing characters") {
+        <serde_json::Error as serde::de::Error>::custom(format!(
+            "`{path}`: more values than the field holds ({inner})"
+        ))
     } else {
         <serde_json::Error as serde::de::Error>::custom(format!("`{path}`: {inner}"))
     }
@@ -98,6 +106,26 @@ pub fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Erro
 mod tests {
     use super::*;
     use crate::Scene;
+
+    #[test]
+    fn a_number_out_of_range_and_a_list_too_long_name_their_field() {
+        let e = |text: &str| from_str::<Scene>(text).unwrap_err().to_string();
+        let m = e(r#"{"clearance_m": 1e400}"#);
+        assert!(
+            m.starts_with("`clearance_m`: number out of range at line 1"),
+            "{m}"
+        );
+        let m = e(r#"{"solver": {"rtol": -1e999}}"#);
+        assert!(m.starts_with("`solver.rtol`: number out of range"), "{m}");
+        let m = e(r#"{"release_offset_m": [1e-5, 0, 0]}"#);
+        assert!(
+            m.starts_with("`release_offset_m`: more values than the field holds (trailing"),
+            "{m}"
+        );
+        // A syntax error between keys names no field (there is none yet).
+        let m = e(r#"{"solver": {"rtol": 1e-4 "x": 1}}"#);
+        assert!(m.starts_with("expected `,` or `}` at line 1"), "{m}");
+    }
 
     #[test]
     fn lists_for_structs_are_refused_with_their_path_and_arrays_pass() {

@@ -73,9 +73,40 @@ pub fn apply_assignment(scene: &mut Scene, assignment: &str) -> Result<(), Overr
     let (key, value) = assignment
         .split_once('=')
         .ok_or_else(|| OverrideError::Syntax(assignment.to_string()))?;
-    let value: Value = serde_json::from_str(value.trim())
-        .unwrap_or_else(|_| Value::String(value.trim().to_string()));
-    apply(scene, key.trim(), value)
+    let (key, text) = (key.trim(), value.trim());
+    // `nan`, `inf`, `1e400`: numbers JSON cannot hold, refused with the field's range.
+    if let Ok(x) = text.parse::<f64>() {
+        if !x.is_finite() {
+            return Err(OverrideError::BadValue {
+                key: key.to_string(),
+                reason: format!(
+                    "{text} is not a finite number; allowed {}",
+                    finite_range(scene, key)
+                ),
+            });
+        }
+    }
+    let value: Value =
+        serde_json::from_str(text).unwrap_or_else(|_| Value::String(text.to_string()));
+    apply(scene, key, value)
+}
+
+/// The range [`Scene::validate`] allows for the number `key`, in its own words, found by
+/// setting the largest finite values of either sign; "a finite number" when the key is not a
+/// number or the validation says nothing of it.
+fn finite_range(scene: &Scene, key: &str) -> String {
+    for extreme in [f64::MAX, -f64::MAX] {
+        let mut s = scene.clone();
+        if apply(&mut s, key, Value::from(extreme)).is_err() {
+            break;
+        }
+        if let Err(e) = s.validate() {
+            if e.field == key {
+                return e.allowed;
+            }
+        }
+    }
+    "a finite number".to_string()
 }
 
 /// Sets the scene parameter `key` (dotted for nested fields) to `value`.
@@ -169,6 +200,33 @@ pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), Overri
 mod tests {
     use super::*;
     use whirlmap_core::FrictionLaw;
+
+    #[test]
+    fn a_number_json_cannot_hold_is_refused_with_the_fields_range() {
+        let mut s = Scene::paper();
+        for (set, says) in [
+            (
+                "clearance_m=nan",
+                "nan is not a finite number; allowed (0, 0.1] m",
+            ),
+            (
+                "solver.rtol=1e400",
+                "1e400 is not a finite number; allowed (0, 1e-2]",
+            ),
+            (
+                "speed_rpm=-inf",
+                "-inf is not a finite number; allowed [-1e6, 1e6] r/min",
+            ),
+            (
+                "unbalance_phase_rad=NaN",
+                "NaN is not a finite number; allowed a finite number",
+            ),
+        ] {
+            let e = apply_assignment(&mut s, set).unwrap_err().to_string();
+            assert!(e.contains(says), "{set}: {e}");
+        }
+        assert_eq!(s, Scene::paper(), "nothing was set");
+    }
 
     #[test]
     fn a_misspelt_key_gets_the_closest_known_one() {
