@@ -131,7 +131,7 @@ fn bad_ensemble_files_exit_2_and_name_the_field() {
         ),
         (
             r#""adaptive": {"seed_speed_points": 2, "seed_mu_points": 2}"#,
-            &["adaptive.seed_speed_points", "at least 2 points"],
+            &["axes.speed_rpm = 1 point", "at least 2 points"],
         ),
     ];
     for (i, (section, words)) in cases.iter().enumerate() {

@@ -48,6 +48,16 @@ fn bad_specs_exit_2_name_the_field_and_run_nothing() {
             &["scene.stop_speed_rpm (the critical search at mu 0.3, speed_rpm.from 1000 r/min) = 1500"],
         ),
         (
+            "a span beyond the largest number",
+            r#"{"name": "bad", "duration_s": 0.05, "axes": {"unbalance_m": {"from": -1e308, "to": 1e308, "steps": 3}}}"#.into(),
+            &["axes.unbalance_m = from -1e308 to 1e308"],
+        ),
+        (
+            "a probability section's own field",
+            format!("{{{base}, \"probability\": {{\"duration_s\": -1, \"axes\": {{\"speed_rpm\": [4000], \"mu\": [0.3]}}, \"ensemble\": {{\"members\": 2, \"seed\": 1}}}}}}"),
+            &["probability.duration_s = -1"],
+        ),
+        (
             "zero steps",
             r#"{"name": "bad", "duration_s": 0.05, "axes": {"mu": {"from": 0.1, "to": 0.3, "steps": 0}}}"#.into(),
             &["axes.mu.steps = 0"],

@@ -85,19 +85,25 @@ impl AdaptiveParams {
             );
         }
         let (speeds, mus) = fine_axes(spec);
-        for (field, n, len) in [
+        for (field, axis, n, len) in [
             (
                 "adaptive.seed_speed_points",
+                "axes.speed_rpm",
                 self.seed_speed_points,
                 speeds.len(),
             ),
-            ("adaptive.seed_mu_points", self.seed_mu_points, mus.len()),
+            (
+                "adaptive.seed_mu_points",
+                "axes.mu",
+                self.seed_mu_points,
+                mus.len(),
+            ),
         ] {
             if len < 2 {
                 return bad(
-                    field,
-                    n.to_string(),
-                    format!("an axis of at least 2 points (it has {len})"),
+                    axis,
+                    format!("{len} point"),
+                    "at least 2 points for an adaptive search (its seed grid has 2 or more)".into(),
                 );
             }
             if n < 2 || n > len {

@@ -152,6 +152,15 @@ pub enum SpecError {
         /// The allowed range in words.
         allowed: String,
     },
+    /// An error of a nested section (a sweep's `probability`), named with the section in
+    /// front of its field: `probability.duration_s = -1: ...`.
+    #[error("{section}{}{source}", if matches!(**source, SpecError::InvalidScene { .. }) { ": " } else { "." })]
+    InSection {
+        /// The section's field.
+        section: String,
+        /// The error inside it.
+        source: Box<SpecError>,
+    },
     /// A grid point whose scene fails validation.
     #[error("grid point {index} ({inputs}): {source}")]
     InvalidScene {
@@ -559,6 +568,13 @@ fn check_range(field: &str, from: f64, to: f64) -> Result<(), SpecError> {
             from,
             to,
         })
+    } else if !(to - from).is_finite() {
+        // Each end finite, their span not (-1e308 to 1e308): its steps would be infinite.
+        Err(SpecError::Invalid {
+            field: field.to_string(),
+            value: format!("from {} to {}", num(from), num(to)),
+            allowed: "a span to - from below 1.8e308 (the largest finite number)".into(),
+        })
     } else {
         Ok(())
     }
@@ -790,17 +806,9 @@ impl SweepSpec {
         }
         if let Some(e) = self.probability_spec() {
             // Grid, draws and every cell with the widest draws.
-            e.cells().map_err(|err| match err {
-                SpecError::Invalid {
-                    field,
-                    value,
-                    allowed,
-                } => SpecError::Invalid {
-                    field: format!("probability.{field}"),
-                    value,
-                    allowed,
-                },
-                other => other,
+            e.cells().map_err(|err| SpecError::InSection {
+                section: "probability".into(),
+                source: Box::new(err),
             })?;
         }
         for c in &self.charts {
