@@ -1234,10 +1234,18 @@ mod tests {
         );
         // A probability section is checked with the sweep (its draws against every cell).
         let e = err(|v| {
-            v["probability"] = serde_json::json!({"axes": {"mu": [0.3]},
+            v["probability"] = serde_json::json!({"axes": {"speed_rpm": [4000], "mu": [0.3]},
                 "ensemble": {"members": 0, "seed": 1}})
         });
-        assert!(e.contains("members"), "{e}");
+        assert!(e.contains("probability.ensemble.members = 0"), "{e}");
+        let e = err(|v| {
+            v["probability"] = serde_json::json!({"axes": {"mu": [0.3]},
+                "ensemble": {"members": 2, "seed": 1}})
+        });
+        assert!(
+            e.contains("probability.axes = mu: allowed a speed_rpm axis"),
+            "{e}"
+        );
         let e = err(|v| v["name"] = Value::from("../x"));
         assert!(e.contains("name"), "{e}");
         let e = err(|v| v["axes"]["mu_dynamic"] = serde_json::json!([0.2]));
