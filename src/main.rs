@@ -289,9 +289,13 @@ pub(crate) fn check_writable(path: &Path) -> anyhow::Result<()> {
     };
     if !dir.is_dir() {
         anyhow::bail!(
-            "cannot write {}: the folder {} does not exist",
+            "cannot write {}: {}",
             path.display(),
-            dir.display()
+            if dir.exists() {
+                format!("{} is a file, not a folder", dir.display())
+            } else {
+                format!("the folder {} does not exist", dir.display())
+            }
         );
     }
     if path.is_dir() {

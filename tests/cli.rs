@@ -320,6 +320,18 @@ fn an_unwritable_chart_path_is_refused_in_a_sentence_before_the_drop_runs() {
     );
     assert!(!err.contains("Os {"), "no error dump: {err}");
     assert!(out.stdout.is_empty(), "nothing was simulated or printed");
+    // A file where the folder should be is named as such.
+    let file = temp_path("a-file");
+    std::fs::write(&file, "").unwrap();
+    let chart = file.join("x.png");
+    let out = whirlmap(&["drop", "--orbit", s(&chart), "--json"]);
+    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains(&format!("{} is a file, not a folder", file.display())),
+        "{}",
+        stderr(&out)
+    );
+    let _ = std::fs::remove_file(&file);
 }
 
 #[test]

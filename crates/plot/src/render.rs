@@ -134,10 +134,11 @@ pub fn check_writable(path: &Path) -> Result<(), RenderError> {
         _ => Path::new("."),
     };
     if !parent.is_dir() {
-        return Err(fail(format!(
-            "the folder {} does not exist",
-            parent.display()
-        )));
+        return Err(fail(if parent.exists() {
+            format!("{} is a file, not a folder", parent.display())
+        } else {
+            format!("the folder {} does not exist", parent.display())
+        }));
     }
     if path.is_dir() {
         return Err(fail("it is a folder".to_string()));
@@ -165,14 +166,16 @@ pub fn check_writable(path: &Path) -> Result<(), RenderError> {
 /// (`ImageError(IoError(Os { code: 28, kind: StorageFull, message: "No space left on
 /// device" }))`); the OS message is what a person needs.
 fn plain_cause(text: &str) -> String {
-    match text
-        .split("message: \"")
-        .nth(1)
-        .and_then(|m| m.split('"').next())
-    {
-        Some(message) => message.to_string(),
-        None => text.to_string(),
-    }
+    // `Os { .. message: "..." }` and `Custom { kind: .., error: "..." }` both end in the words.
+    let words = |key: &str| {
+        text.split(key)
+            .nth(1)
+            .and_then(|m| m.split('"').next())
+            .map(str::to_string)
+    };
+    words("message: \"")
+        .or_else(|| words("error: \""))
+        .unwrap_or_else(|| text.to_string())
 }
 
 pub(crate) fn draw_and_present<DB: DrawingBackend, F: Figure>(

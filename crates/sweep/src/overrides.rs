@@ -23,6 +23,14 @@ pub enum OverrideError {
         /// The known keys at that level, comma-separated.
         known: String,
     },
+    /// The key goes on past a value that has no fields (`solver.rtol.x`).
+    #[error("unknown scene parameter `{key}`: {hint}")]
+    NotASection {
+        /// The key as given.
+        key: String,
+        /// What the value before the extra part is, and how to set it.
+        hint: String,
+    },
     /// The value has the wrong type for the key.
     #[error("invalid value for `{key}`: {reason}")]
     BadValue {
@@ -138,11 +146,18 @@ pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), Overri
     for (i, part) in parts.iter().enumerate() {
         let obj = match node {
             Value::Object(m) => m,
-            _ => {
-                return Err(OverrideError::UnknownKey {
+            other => {
+                let parent = parts[..i].join(".");
+                return Err(OverrideError::NotASection {
                     key: key.to_string(),
-                    suggestion: None,
-                    known: String::new(),
+                    hint: match other {
+                        Value::Array(items) => format!(
+                            "`{parent}` is a list of {}: set it whole, e.g. `--set {parent}={}`",
+                            items.len(),
+                            Value::Array(items.clone())
+                        ),
+                        _ => format!("`{parent}` is a single value: it has no fields"),
+                    },
                 });
             }
         };
@@ -180,15 +195,22 @@ pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), Overri
         // An optional section that is absent (e.g. `thermal` on a drop without it) has no
         // sub-keys to set: say so instead of failing deeper.
         let Some(next) = obj.get_mut(*part) else {
-            // `whirlmap drop` has a flag that switches each optional section on.
-            let flag = match *part {
-                "thermal" | "bearing" => format!(", or pass --{part} to `whirlmap drop`"),
-                _ => String::new(),
+            // `whirlmap drop` has a flag that switches each optional section on; the other
+            // optional fields are values (a number, a list), set whole.
+            let known = match *part {
+                "thermal" | "bearing" => format!(
+                    "none (`{part}` is not set in this scene: set it whole first, e.g. \
+                     `--set {part}={{}}`, or pass --{part} to `whirlmap drop`)"
+                ),
+                _ => format!(
+                    "none (`{part}` is a value, not a section: set it whole, \
+                     `--set {part}=VALUE`; `whirlmap scene --schema` gives its form)"
+                ),
             };
             return Err(OverrideError::UnknownKey {
                 key: key.to_string(),
                 suggestion: None,
-                known: format!("none (`{part}` is not set in this scene: set it whole first, e.g. `--set {part}={{}}`{flag})"),
+                known,
             });
         };
         node = next;
@@ -200,6 +222,34 @@ pub fn set_value(root: &mut Value, key: &str, value: Value) -> Result<(), Overri
 mod tests {
     use super::*;
     use whirlmap_core::FrictionLaw;
+
+    #[test]
+    fn a_key_past_a_value_says_what_the_value_is() {
+        let mut s = Scene::paper();
+        let e = apply_assignment(&mut s, "solver.rtol.x=1")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`solver.rtol` is a single value: it has no fields"),
+            "{e}"
+        );
+        let e = apply_assignment(&mut s, "release_offset_m.0=1")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`release_offset_m` is a value, not a section"),
+            "{e}"
+        );
+        assert!(!e.contains("={}"), "{e}");
+        s.release_offset_m = [1e-5, 0.0];
+        let e = apply_assignment(&mut s, "release_offset_m.0=1")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`release_offset_m` is a list of 2: set it whole, e.g. `--set release_offset_m=[0.00001,0.0]`"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn a_number_json_cannot_hold_is_refused_with_the_fields_range() {
