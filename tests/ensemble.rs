@@ -130,6 +130,10 @@ fn bad_ensemble_files_exit_2_and_name_the_field() {
             &["ensemble.levels"],
         ),
         (
+            r#""ensemble": {"members": 2, "seed": 1, "levels": [0.5, 0.5]}"#,
+            &["ensemble.levels = 0.5: allowed each level once"],
+        ),
+        (
             r#""adaptive": {"seed_speed_points": 2, "seed_mu_points": 2}"#,
             &["axes.speed_rpm = 1 point", "at least 2 points"],
         ),
@@ -146,6 +150,24 @@ fn bad_ensemble_files_exit_2_and_name_the_field() {
         }
         assert!(!out.join("members.jsonl").exists(), "nothing runs");
     }
+    // An adaptive search over values out of order: its cells would not be neighbours.
+    let f = dir.join("unsorted.json");
+    std::fs::write(
+        &f,
+        r#"{"name": "unsorted", "duration_s": 0.05,
+            "axes": {"speed_rpm": [4000, 2000, 6000], "mu": [0.3, 0.4]},
+            "adaptive": {"seed_speed_points": 2, "seed_mu_points": 2}}"#,
+    )
+    .unwrap();
+    let out = dir.join("unsorted");
+    let o = whirlmap(&["adaptive", s(&f), "--out", s(&out)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("allowed values in ascending order"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.join("adaptive.json").exists());
     // No speed axis: nothing for the contours to cross along; refused before any drop.
     let f = dir.join("nospeed.json");
     std::fs::write(

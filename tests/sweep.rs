@@ -58,6 +58,11 @@ fn bad_specs_exit_2_name_the_field_and_run_nothing() {
             &["probability.duration_s = -1"],
         ),
         (
+            "a chart of a model the scene does not run",
+            format!("{{{base}, \"charts\": [\"classes\", \"peak_temperature\"]}}"),
+            &["charts = peak_temperature: allowed a chart of the thermal model only with `scene.thermal` set"],
+        ),
+        (
             "zero steps",
             r#"{"name": "bad", "duration_s": 0.05, "axes": {"mu": {"from": 0.1, "to": 0.3, "steps": 0}}}"#.into(),
             &["axes.mu.steps = 0"],

@@ -230,6 +230,35 @@ impl AccuracySpec {
                 }
             }
         }
+        // Rows are named by case and setting, and a ladder's rungs by their tolerance: each
+        // must be told apart.
+        let twice = |field: &dyn Fn(usize) -> String, names: Vec<String>| {
+            for (i, n) in names.iter().enumerate() {
+                if names[..i].contains(n) {
+                    return Err(AccuracySpecError::Range {
+                        field: field(i),
+                        value: n.clone(),
+                        allowed: "a value not used before in the list".into(),
+                    });
+                }
+            }
+            Ok(())
+        };
+        let text = |r: &Vec<f64>| r.iter().map(|r| r.to_string()).collect();
+        twice(
+            &|i| format!("cases[{i}].name"),
+            self.cases.iter().map(|c| c.name.clone()).collect(),
+        )?;
+        twice(
+            &|i| format!("settings[{i}].name"),
+            self.settings.iter().map(|s| s.name.clone()).collect(),
+        )?;
+        twice(&|i| format!("rtol[{i}]"), text(&self.rtol))?;
+        for (j, st) in self.settings.iter().enumerate() {
+            if let Some(r) = &st.rtol {
+                twice(&|i| format!("settings[{j}].rtol[{i}]"), text(r))?;
+            }
+        }
         if self.cases.is_empty() {
             return Err(AccuracySpecError::Range {
                 field: "cases".into(),
@@ -853,5 +882,30 @@ mod tests {
         assert!(spec(r#"{"solver.method": "dopri5"}"#, "")
             .validate()
             .is_ok());
+    }
+
+    #[test]
+    fn names_and_tolerances_are_each_given_once() {
+        let spec = |text: &str| -> String {
+            serde_json::from_str::<AccuracySpec>(text)
+                .unwrap()
+                .validate()
+                .unwrap_err()
+                .to_string()
+        };
+        let e = spec(
+            r#"{"rtol": [1e-4], "cases": [{"name": "a", "scene": {}}, {"name": "a", "scene": {}}],
+                "settings": []}"#,
+        );
+        assert!(e.starts_with("cases[1].name = a"), "{e}");
+        let e = spec(
+            r#"{"rtol": [1e-4, 1e-5, 1e-4], "cases": [{"name": "a", "scene": {}}], "settings": []}"#,
+        );
+        assert!(e.starts_with("rtol[2] = 0.0001"), "{e}");
+        let e = spec(
+            r#"{"rtol": [1e-4], "cases": [{"name": "a", "scene": {}}],
+                "settings": [{"name": "x", "scene": {}}, {"name": "x", "scene": {}}]}"#,
+        );
+        assert!(e.starts_with("settings[1].name = x"), "{e}");
     }
 }

@@ -106,6 +106,21 @@ impl AdaptiveParams {
                     "at least 2 points for an adaptive search (its seed grid has 2 or more)".into(),
                 );
             }
+            // Cells are between neighbouring values: the values must be in order.
+            let values = if axis == "axes.speed_rpm" {
+                &speeds
+            } else {
+                &mus
+            };
+            if values.windows(2).any(|w| !(w[0] < w[1])) {
+                return bad(
+                    axis,
+                    format!("{values:?}"),
+                    "values in ascending order for an adaptive search (a cell lies between \
+                     neighbouring values)"
+                        .into(),
+                );
+            }
             if n < 2 || n > len {
                 return bad(
                     field,

@@ -292,9 +292,12 @@ impl EnsembleParams {
         if self.levels.is_empty() {
             return Err(invalid("ensemble.levels", "[]", "at least one level"));
         }
-        for l in &self.levels {
+        for (i, l) in self.levels.iter().enumerate() {
             if !(*l > 0.0 && *l < 1.0) {
                 return Err(invalid("ensemble.levels", l, "each in (0, 1)"));
+            }
+            if self.levels[..i].contains(l) {
+                return Err(invalid("ensemble.levels", l, "each level once"));
             }
         }
         for (name, d) in self.dists() {

@@ -818,6 +818,32 @@ impl SweepSpec {
                     known: CHART_NAMES.join(", "),
                 });
             }
+            // A chart of a model the scene does not run would be silently left out.
+            let axis_sets = |section: &str| {
+                self.axes
+                    .0
+                    .iter()
+                    .any(|a| a.name == section || a.name.starts_with(&format!("{section}.")))
+            };
+            let needs = match c.as_str() {
+                "peak_temperature" => Some(("thermal", self.base_scene().thermal.is_some())),
+                "drops_to_failure" | "contact_pressure" => {
+                    Some(("bearing", self.base_scene().bearing.is_some()))
+                }
+                _ => None,
+            };
+            if let Some((section, on)) = needs {
+                if !on && !axis_sets(section) {
+                    return Err(SpecError::Invalid {
+                        field: "charts".into(),
+                        value: c.clone(),
+                        allowed: format!(
+                            "a chart of the {section} model only with `scene.{section}` set \
+                             (the records carry nothing to draw without it)"
+                        ),
+                    });
+                }
+            }
         }
         Ok(())
     }
