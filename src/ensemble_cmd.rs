@@ -80,6 +80,20 @@ type Loaded = (ensemble::EnsembleSpec, PathBuf, FolderLock, Option<PathBuf>);
 /// files already there aside.
 fn load(a: &EnsembleArgs, what: &str, resume: bool) -> Result<Loaded, Failure> {
     let s = ensemble::load(&a.file).map_err(|e| Failure::coded(2, e))?;
+    // The section the command runs, before any folder is made.
+    let (has, section) = match what {
+        "adaptive" => (s.adaptive.is_some(), "an adaptive"),
+        _ => (s.ensemble.is_some(), "an ensemble"),
+    };
+    if !has {
+        return Err(Failure::coded(
+            2,
+            format!(
+                "{}: {what} = (missing): allowed {section} section (docs/probability.md)",
+                a.file.display()
+            ),
+        ));
+    }
     let out = a
         .out
         .clone()

@@ -56,6 +56,14 @@ pub fn run(a: &RenderArgs) -> Result<(), RenderFailure> {
         );
         return Ok(());
     }
+    // Nothing to draw from: refused before the folder is locked (no lock file left in it).
+    if !a.dir.join(POINTS_FILE).is_file() && !a.dir.join(CONTOURS_FILE).is_file() {
+        return Err(RenderFailure::Input(anyhow::anyhow!(
+            "no sweep results: {} holds neither {POINTS_FILE} (a sweep's) nor {CONTOURS_FILE} \
+             (an ensemble's)",
+            a.dir.display()
+        )));
+    }
     let _lock = FolderLock::acquire(&a.dir, "render").map_err(|e| match e.exit_code() {
         4 => RenderFailure::Output(e.into()),
         _ => RenderFailure::Input(e.into()),

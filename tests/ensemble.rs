@@ -201,12 +201,19 @@ fn bad_ensemble_files_exit_2_and_name_the_field() {
         "{}",
         stderr(&o)
     );
-    // No ensemble section: `ensemble` refuses.
+    // No ensemble (or adaptive) section: refused, and no folder made.
     let f = dir.join("none.json");
     std::fs::write(&f, format!("{{{base}}}")).unwrap();
-    let o = whirlmap(&["ensemble", s(&f), "--out", s(&dir.join("none"))]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("ensemble"));
+    for what in ["ensemble", "adaptive"] {
+        let o = whirlmap(&[what, s(&f), "--out", s(&dir.join("none"))]);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(
+            stderr(&o).contains(&format!("{what} = (missing)")),
+            "{}",
+            stderr(&o)
+        );
+        assert!(!dir.join("none").exists());
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -887,6 +887,10 @@ fn runs_of_different_kinds_never_share_a_folder() {
 
     let empty = dir.join("empty");
     std::fs::create_dir_all(&empty).unwrap();
+    // A folder without results: refused, and no lock file left in it.
+    let o = whirlmap(&["render", s(&empty)]);
+    assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
+    assert_eq!(std::fs::read_dir(&empty).unwrap().count(), 0);
     std::fs::write(empty.join("points.jsonl"), "").unwrap();
     let o = whirlmap(&["render", s(&empty)]);
     assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
