@@ -563,6 +563,14 @@ pub fn start_run(
     opts: &RunOptions,
     shard: Option<&crate::shard::Shard>,
 ) -> Result<SweepRun, SweepError> {
+    // A big grid takes a while to check (about 4 us a point): say so, not nothing.
+    if spec.len() >= 100_000 {
+        progress_line(&format!(
+            "sweep {}: checking the scenes of {} grid points before any drop runs",
+            spec.name,
+            spec.len()
+        ));
+    }
     spec.check_points()?;
     let threads = match opts.threads {
         Some(n) => n,
