@@ -45,6 +45,15 @@ fn the_record_has_the_bearing_fields_only_with_the_analysis() {
 }
 
 fn sweep(name: &str, scene: &str) -> std::path::PathBuf {
+    sweep_drawing(
+        name,
+        scene,
+        r#"["drops_to_failure", "contact_pressure", "classes"]"#,
+    )
+}
+
+/// [`sweep`] drawing `charts` (a JSON list).
+fn sweep_drawing(name: &str, scene: &str, charts: &str) -> std::path::PathBuf {
     let dir = temp_dir(name);
     // 2000 r/min at mu 0.1 settles as a pendulum; 16 000 r/min at mu 0.4 whirls.
     let spec = spec_file(
@@ -54,7 +63,7 @@ fn sweep(name: &str, scene: &str) -> std::path::PathBuf {
             r#"{{"name": "{name}", "scene": {scene}, "duration_s": 0.3,
                 "axes": {{"speed_rpm": {{"from": 2000, "to": 16000, "steps": 2}},
                           "mu": {{"from": 0.1, "to": 0.4, "steps": 2}}}},
-                "charts": ["drops_to_failure", "contact_pressure", "classes"]}}"#
+                "charts": {charts}}}"#
         ),
     );
     let out_dir = dir.join("out");
@@ -152,16 +161,37 @@ fn merged_shards_write_the_same_bearing_report() {
 
 #[test]
 fn a_sweep_without_the_analysis_keeps_its_columns() {
-    let out_dir = sweep("no-life-sweep", "{}");
+    let out_dir = sweep_drawing("no-life-sweep", "{}", r#"["classes"]"#);
     let summary = std::fs::read_to_string(out_dir.join("summary.csv")).unwrap();
     let header = summary.lines().next().unwrap();
     for key in FIELDS {
         assert!(!header.contains(key), "{header}");
     }
-    // Only the class map: the bearing charts need the analysis's results.
     assert!(out_dir.join("charts/classes.png").exists());
-    assert!(!out_dir.join("charts/drops_to_failure.png").exists());
     assert!(!out_dir.join("bearing.md").exists());
+    // The bearing charts need the analysis's results: asking for them without it is refused
+    // before any drop (it drew the class map alone, in silence).
+    let dir = temp_dir("no-life-charts");
+    let spec = spec_file(
+        &dir,
+        "spec",
+        r#"{"name": "x", "duration_s": 0.05, "axes": {"speed_rpm": [2000], "mu": [0.1]},
+            "charts": ["drops_to_failure", "classes"]}"#,
+    );
+    let out = whirlmap(&[
+        "sweep",
+        s(&spec),
+        "--out",
+        s(&dir.join("out")),
+        "--no-progress",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("charts = drops_to_failure: allowed a chart of the bearing model"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!dir.join("out/points.jsonl").exists());
 }
 
 /// A drop that must be refused as bad input: exit 2, and the message on stderr.
