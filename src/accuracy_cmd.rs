@@ -55,6 +55,9 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
         .with_context(|| format!("cannot create {}", a.out.display()))
         .map_err(Failure::Output)?;
     let storage = |e: whirlmap_sweep::sweep::SweepError| Failure::coded(e.exit_code(), e);
+    // One writer at a time: a sweep or another study writing the folder refuses this one
+    // (exit 2), and this one holds the folder until it ends.
+    let _lock = whirlmap_sweep::folder::FolderLock::acquire(&a.out, "accuracy").map_err(storage)?;
     let previous = if a.overwrite {
         whirlmap_sweep::folder::move_owned_aside(&a.out).map_err(storage)?
     } else {
@@ -92,8 +95,10 @@ pub fn run_cmd(a: &AccuracyArgs) -> Result<(), Failure> {
         STUDY_FILE,
         serde_json::to_string_pretty(&study).expect("a study serialises"),
     )?;
-    draw_charts(&a.out, &spec.name, &study)?;
+    // The study is written: the earlier run's files go (before the charts, so a chart that
+    // fails does not leave both).
     whirlmap_sweep::folder::release_previous(previous).map_err(storage)?;
+    draw_charts(&a.out, &spec.name, &study)?;
     outln!("{md}");
     errln!("written to {}", a.out.display());
     Ok(())

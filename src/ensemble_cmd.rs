@@ -27,7 +27,7 @@ pub struct EnsembleArgs {
     overwrite: bool,
     /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::MAX_THREADS as i64))]
-    threads: Option<u32>,
+    pub(crate) threads: Option<u32>,
     /// No progress lines.
     #[arg(long)]
     no_progress: bool,
@@ -39,7 +39,7 @@ pub struct EnsembleArgs {
 pub struct EnsembleCmdArgs {
     /// The arguments `adaptive` takes too.
     #[command(flatten)]
-    common: EnsembleArgs,
+    pub(crate) common: EnsembleArgs,
     /// Refused: the full-grid comparison is `adaptive`'s.
     #[arg(long, hide = true)]
     compare_full: bool,
@@ -56,7 +56,7 @@ pub struct EnsembleCmdArgs {
 pub struct AdaptiveArgs {
     /// The arguments `ensemble` takes too.
     #[command(flatten)]
-    common: EnsembleArgs,
+    pub(crate) common: EnsembleArgs,
     /// Also run the full fine grid and report how the boundaries agree.
     #[arg(long)]
     compare_full: bool,
@@ -157,6 +157,9 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
         args.resume,
     )
     .map_err(failure)?;
+    // Its results are written: the earlier run's files go (before the charts, so a chart
+    // that fails does not leave both).
+    whirlmap_sweep::folder::release_previous(previous).map_err(failure)?;
     let resumed = if o.resumed > 0 {
         format!(" ({} resumed)", o.resumed)
     } else {
@@ -203,7 +206,6 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
     let w = whirlmap_plot::probability::render_probability(&out)
         .map_err(|e| Failure::coded(4, format!("charts: {e}")))?;
     outln!("  output           {} ({} charts)", out.display(), w.len());
-    whirlmap_sweep::folder::release_previous(previous).map_err(failure)?;
     Ok(Done::flagged_if(o.failed > 0))
 }
 
@@ -220,6 +222,7 @@ pub fn run_adaptive_cmd(args: &AdaptiveArgs) -> CmdResult {
         args.resume,
     )
     .map_err(failure)?;
+    whirlmap_sweep::folder::release_previous(previous).map_err(failure)?;
     outln!(
         "adaptive {}: {} of {} drops ({:.1} %) for a {} x {} grid from a {} x {} seed, {} rounds, {} boundary cells",
         r.name,
@@ -240,7 +243,6 @@ pub fn run_adaptive_cmd(args: &AdaptiveArgs) -> CmdResult {
             g.max_shift_cells, g.columns_differing, g.points_differing
         );
     }
-    whirlmap_sweep::folder::release_previous(previous).map_err(failure)?;
     outln!("  output           {}", path.display());
     Ok(Done::flagged_if(
         r.evaluated.iter().any(|c| c.p_whirl.is_nan()),

@@ -609,25 +609,41 @@ fn main() -> ExitCode {
 /// The most worker threads any command takes (`--threads`'s range).
 const MAX_THREADS: usize = 4096;
 
-/// Refuses a `RAYON_NUM_THREADS` above [`MAX_THREADS`], which the commands without
-/// `--threads` would otherwise start (rayon reads it; 99 999 threads ran out of memory before
-/// any work). Values rayon ignores (not a number) and 0 (one per core) pass.
-fn check_thread_env() -> Result<(), Failure> {
-    let Ok(text) = std::env::var("RAYON_NUM_THREADS") else {
-        return Ok(());
+/// Refuses a thread count from the environment above [`MAX_THREADS`] (`RAYON_NUM_THREADS`,
+/// or the older `RAYON_RS_NUM_CPUS` that rayon also reads) for a command that takes rayon's
+/// default pool: one without `--threads` (99 999 threads ran out of memory before any work).
+/// Values rayon ignores (not a number) and 0 (one per core) pass.
+fn check_thread_env(command: &Command) -> Result<(), Failure> {
+    let default_pool = match command {
+        Command::Critical(_) | Command::Merge(_) | Command::Compare(_) | Command::Render(_) => true,
+        Command::Sweep(a) => a.threads.is_none(),
+        Command::Ensemble(a) => a.common.threads.is_none(),
+        Command::Adaptive(a) => a.common.threads.is_none(),
+        _ => false,
     };
-    match text.trim().parse::<usize>() {
-        Ok(n) if n > MAX_THREADS => Err(Failure::Input(anyhow::anyhow!(
-            "RAYON_NUM_THREADS = {n}: allowed [1, {MAX_THREADS}] (0 or unset: one per core)"
-        ))),
-        _ => Ok(()),
+    if !default_pool {
+        return Ok(());
     }
+    for var in ["RAYON_NUM_THREADS", "RAYON_RS_NUM_CPUS"] {
+        let Ok(text) = std::env::var(var) else {
+            continue;
+        };
+        if let Ok(n) = text.trim().parse::<usize>() {
+            if n > MAX_THREADS {
+                return Err(Failure::Input(anyhow::anyhow!(
+                    "{var} = {n}: allowed [1, {MAX_THREADS}] (0 or unset: one per core), or \
+                     give --threads where the command has it"
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Runs the command; returns its exit code.
 fn run() -> u8 {
     let cli = Cli::parse();
-    if let Err(f) = check_thread_env() {
+    if let Err(f) = check_thread_env(&cli.command) {
         errln!("error: {:#}", f.error());
         return f.code();
     }

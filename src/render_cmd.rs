@@ -56,8 +56,22 @@ pub fn run(a: &RenderArgs) -> Result<(), RenderFailure> {
         );
         return Ok(());
     }
-    // Nothing to draw from: refused before the folder is locked (no lock file left in it).
-    if !a.dir.join(POINTS_FILE).is_file() && !a.dir.join(CONTOURS_FILE).is_file() {
+    // Nothing to draw from: refused before the folder is locked (no lock file left in it): no
+    // records (a points.jsonl whose first megabyte holds no whole line) and no contours.
+    let records = std::fs::File::open(a.dir.join(POINTS_FILE)).is_ok_and(|f| {
+        let mut head = Vec::new();
+        std::io::Read::read_to_end(&mut std::io::Read::take(f, 1 << 20), &mut head).is_ok()
+            && (head.contains(&b'\n') || head.len() == 1 << 20)
+    });
+    // (A folder a run is writing is refused as in use, below, whatever it holds yet.)
+    let writing = folder::running_writer(&a.dir).is_some();
+    if !writing && !records && !a.dir.join(CONTOURS_FILE).is_file() {
+        if a.dir.join(POINTS_FILE).is_file() {
+            return Err(RenderFailure::Input(anyhow::anyhow!(
+                "{}: line 1: no sweep results: the file holds no complete record",
+                a.dir.join(POINTS_FILE).display()
+            )));
+        }
         return Err(RenderFailure::Input(anyhow::anyhow!(
             "no sweep results: {} holds neither {POINTS_FILE} (a sweep's) nor {CONTOURS_FILE} \
              (an ensemble's)",

@@ -438,16 +438,24 @@ fn a_flag_and_a_set_that_switch_a_model_both_ways_are_refused() {
     assert!(!chart.exists());
 }
 
-/// `RAYON_NUM_THREADS` beyond the `--threads` range is refused (exit 2) before any work: the
-/// commands without `--threads` would start that many threads.
+/// `RAYON_NUM_THREADS` beyond the `--threads` range is refused (exit 2) before any work by a
+/// command that would start that many threads (one without `--threads`); a command that starts
+/// none, or is given `--threads`, runs.
 #[test]
 fn a_thread_count_from_the_environment_beyond_the_range_is_refused() {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_whirlmap"))
-        .args(["drop", "--duration-s", "0.01"])
-        .env("RAYON_NUM_THREADS", "99999")
-        .output()
-        .unwrap();
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_whirlmap"))
+            .args(args)
+            .env("RAYON_NUM_THREADS", "99999")
+            .output()
+            .unwrap()
+    };
+    let o = run(&["critical", "--mu", "0.4", "--from", "6000", "--to", "7000"]);
     assert_eq!(o.status.code(), Some(2), "{}", out(&o));
     assert!(stderr(&o).contains("RAYON_NUM_THREADS = 99999: allowed [1, 4096]"));
     assert!(o.stdout.is_empty());
+    let o = run(&["drop", "--duration-s", "0.01"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out(&o));
+    let o = run(&["scene"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out(&o));
 }

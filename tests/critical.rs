@@ -524,6 +524,24 @@ fn a_kept_drop_log_resumes_a_killed_search_and_answers_a_rerun() {
         std::fs::read_to_string(&csv).unwrap(),
         "speed,class\n6000,whirl\n"
     );
+    // A one-line file without its newline (a scene named by mistake): refused, untouched.
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, r#"{"speed_rpm": 8000, "mu_dynamic": 0.3}"#).unwrap();
+    let refused = whirlmap(&search(&scene, "1"));
+    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+    assert_eq!(
+        std::fs::read_to_string(&scene).unwrap(),
+        r#"{"speed_rpm": 8000, "mu_dynamic": 0.3}"#
+    );
+    // A torn line of the log itself is cut, and the search is the full one.
+    let torn = dir.join("torn.jsonl");
+    let mut text = String::from_utf8(before.clone()).unwrap();
+    text.push_str(r#"{"mu":0.4,"speed_rpm":60"#);
+    std::fs::write(&torn, text).unwrap();
+    let again = whirlmap(&search(&torn, "1"));
+    assert!(again.stdout == full.stdout, "{}", stderr(&again));
+    assert!(stderr(&again).contains(&format!("{drops} drops reused")));
+    assert_eq!(lines(&torn) as u64, drops);
     // A directory is a bad path (exit 2), not a failed disk.
     let refused = whirlmap(&search(&dir, "1"));
     assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));

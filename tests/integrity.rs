@@ -123,6 +123,25 @@ fn a_second_writer_is_refused_and_a_killed_writer_leaves_no_lock() {
             "{err}"
         );
     }
+    // So does a study or an ensemble told to overwrite the folder: nothing of the run's moves.
+    let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/accuracy-cases.json");
+    let ens = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/ensemble-smoke.json");
+    for args in [
+        vec![
+            "accuracy",
+            "--cases",
+            s(&cases),
+            "--out",
+            s(&out),
+            "--overwrite",
+        ],
+        vec!["ensemble", s(&ens), "--out", s(&out), "--overwrite"],
+    ] {
+        let o = whirlmap(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", out_text(&o));
+        assert!(stderr(&o).contains("in use"), "{}", stderr(&o));
+        assert!(out.join("manifest.json").is_file() && !out.join("previous-run").exists());
+    }
     // `render` waits its turn too.
     let o = whirlmap(&["render", s(&out)]);
     assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
@@ -895,5 +914,6 @@ fn runs_of_different_kinds_never_share_a_folder() {
     let o = whirlmap(&["render", s(&empty)]);
     assert_eq!(o.status.code(), Some(2), "{}", out_text(&o));
     assert!(stderr(&o).contains("no complete record"), "{}", stderr(&o));
+    assert!(!empty.join(".whirlmap.lock").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -206,24 +206,40 @@ impl AccuracySpec {
                 )?;
             }
         }
-        // A setting's tolerance and step budget are the ladder's and the study's: one in its
-        // scene would be silently replaced.
-        for (j, st) in self.settings.iter().enumerate() {
-            for (key, by) in [
-                ("rtol", format!("settings[{j}].rtol")),
+        // Every run's tolerance and step budget are the study's (its ladder, a setting's own
+        // ladder, the reference's and the presets' tolerances): one in a case's or a
+        // setting's scene would be silently replaced.
+        let scenes = self
+            .cases
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
                 (
-                    "max_step_attempts",
-                    "the study's max_step_attempts".to_string(),
-                ),
+                    format!("cases[{i}]"),
+                    &c.scene,
+                    "each run's ladder or preset",
+                )
+            })
+            .chain(self.settings.iter().enumerate().map(|(j, st)| {
+                let ladder = if st.rtol.is_some() {
+                    "the setting's own rtol ladder"
+                } else {
+                    "the study's rtol ladder"
+                };
+                (format!("settings[{j}]"), &st.scene, ladder)
+            }));
+        for (place, scene, ladder) in scenes {
+            for (key, by) in [
+                ("rtol", ladder),
+                ("max_step_attempts", "the study's max_step_attempts"),
             ] {
-                let nested = st
-                    .scene
+                let nested = scene
                     .get("solver")
                     .and_then(|v| v.as_object())
                     .and_then(|o| o.get(key));
-                if let Some(v) = st.scene.get(&format!("solver.{key}")).or(nested) {
+                if let Some(v) = scene.get(&format!("solver.{key}")).or(nested) {
                     return Err(AccuracySpecError::Range {
-                        field: format!("settings[{j}].scene.solver.{key}"),
+                        field: format!("{place}.scene.solver.{key}"),
                         value: v.to_string(),
                         allowed: format!("no value here: {by} sets it"),
                     });
@@ -879,6 +895,15 @@ mod tests {
             let e = err(s, "");
             assert!(e.starts_with("settings[0].scene.solver.rtol"), "{e}");
         }
+        let e = err(r#"{"solver.rtol": 5}"#, "");
+        assert!(e.ends_with("the study's rtol ladder sets it"), "{e}");
+        let case: AccuracySpec = serde_json::from_str(
+            r#"{"rtol": [1e-4], "cases": [{"name": "a", "scene": {"solver.rtol": 1e-6}}],
+                "settings": []}"#,
+        )
+        .unwrap();
+        let e = case.validate().unwrap_err().to_string();
+        assert!(e.starts_with("cases[0].scene.solver.rtol = 1e-6"), "{e}");
         assert!(spec(r#"{"solver.method": "dopri5"}"#, "")
             .validate()
             .is_ok());

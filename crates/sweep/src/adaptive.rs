@@ -102,7 +102,7 @@ impl AdaptiveParams {
             if len < 2 {
                 return bad(
                     axis,
-                    format!("{len} point"),
+                    format!("{len} point{}", if len == 1 { "" } else { "s" }),
                     "at least 2 points for an adaptive search (its seed grid has 2 or more)".into(),
                 );
             }

@@ -216,6 +216,19 @@ impl DropLog {
             known.insert(l.key(), class);
         }
         if whole < bytes.len() {
+            // A kill tears a line of this log, which starts as every line does; anything
+            // else without its newline is another file's (a one-line JSON file), left as it
+            // is.
+            let tail = &bytes[whole..];
+            let start = br#"{"mu":"#;
+            if !(tail.starts_with(start) || start.starts_with(tail)) {
+                return Err(KeptLogError::NotALog {
+                    path: path.to_path_buf(),
+                    line: bytes[..whole].iter().filter(|b| **b == b'\n').count() + 1,
+                    reason: "it does not end with a newline, and is not a torn line of this log"
+                        .into(),
+                });
+            }
             file.set_len(whole as u64).map_err(io)?;
         }
         Ok(Self {

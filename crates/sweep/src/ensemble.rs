@@ -74,8 +74,8 @@ use whirlmap_results::manifest::{EnsembleManifest, SortedKeys};
 pub const CELLS_CSV: &str = whirlmap_results::files::CELLS_CSV_FILE;
 
 /// The most cells an ensemble (or an adaptive map's fine grid) may have: every cell is held
-/// in memory with its scene while it runs (1e6 cells took 1.7 GB).
-pub const MAX_CELLS: usize = 1_000_000;
+/// in memory with its scene while it runs (1e6 cells took 1.7 GB; this bound, some 350 MB).
+pub const MAX_CELLS: usize = 200_000;
 pub use whirlmap_results::contours::{ContourGroup, ContoursFile, LevelCrossing};
 pub use whirlmap_results::files::{CELLS_FILE, CONTOURS_FILE, MANIFEST_FILE, MEMBERS_FILE};
 
@@ -438,7 +438,11 @@ impl EnsembleSpec {
             let names: Vec<&str> = self.axes.0.iter().map(|a| a.name.as_str()).collect();
             return Err(SpecError::Invalid {
                 field: "axes".into(),
-                value: names.join(", "),
+                value: if names.is_empty() {
+                    "(none)".into()
+                } else {
+                    names.join(", ")
+                },
                 allowed: "a speed_rpm axis among them: the probability contours are release \
                           speeds"
                     .into(),

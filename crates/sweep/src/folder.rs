@@ -313,8 +313,9 @@ impl RunFolder {
                 dir.display(),
                 present.join(", "),
                 describe_manifest(dir),
-                // `merge` writes its folder whole: it has no --resume.
-                if what == "merge" {
+                // `merge` writes its folder whole: it has no --resume; and only a sweep's
+                // folder (its records) holds a run a sweep can continue.
+                if what == "merge" || !dir.join(POINTS_FILE).exists() {
                     ""
                 } else {
                     "--resume to continue that run (the same spec), "

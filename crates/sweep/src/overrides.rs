@@ -82,9 +82,18 @@ pub fn apply_assignment(scene: &mut Scene, assignment: &str) -> Result<(), Overr
         .split_once('=')
         .ok_or_else(|| OverrideError::Syntax(assignment.to_string()))?;
     let (key, text) = (key.trim(), value.trim());
-    // `nan`, `inf`, `1e400`: numbers JSON cannot hold, refused with the field's range.
+    // `nan`, `inf`, `1e400`: numbers JSON cannot hold, refused with the field's range when
+    // the key is a number field (an unknown key says so first; another field, an enum's,
+    // reads the text as it would any other).
     if let Ok(x) = text.parse::<f64>() {
-        if !x.is_finite() {
+        let numeric = match apply(&mut scene.clone(), key, Value::from(0.0)) {
+            Ok(()) => true,
+            Err(e @ (OverrideError::UnknownKey { .. } | OverrideError::NotASection { .. })) => {
+                return Err(e)
+            }
+            Err(_) => false,
+        };
+        if !x.is_finite() && numeric {
             return Err(OverrideError::BadValue {
                 key: key.to_string(),
                 reason: format!(
@@ -276,6 +285,15 @@ mod tests {
             assert!(e.contains(says), "{set}: {e}");
         }
         assert_eq!(s, Scene::paper(), "nothing was set");
+        // The key is checked first; a field that is not a number reads the text as text.
+        let e = apply_assignment(&mut s, "clearnce_m=nan")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("did you mean `clearance_m`"), "{e}");
+        let e = apply_assignment(&mut s, "solver.method=inf")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown variant `inf`"), "{e}");
     }
 
     #[test]

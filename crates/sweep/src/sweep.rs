@@ -564,7 +564,7 @@ pub fn start_run(
     shard: Option<&crate::shard::Shard>,
 ) -> Result<SweepRun, SweepError> {
     // A big grid takes a while to check (about 4 us a point): say so, not nothing.
-    if spec.len() >= 100_000 {
+    if spec.len() >= 100_000 && matches!(opts.progress, ProgressMode::Auto) {
         progress_line(&format!(
             "sweep {}: checking the scenes of {} grid points before any drop runs",
             spec.name,
