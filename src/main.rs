@@ -156,7 +156,8 @@ enum Command {
     /// right-hand-side evaluation.
     Bench(bench::BenchArgs),
     /// Draw the design charts (Figs. 3-6, class map) of a sweep's results directory into
-    /// DIR/charts/ as PNG and SVG (exit 2 if DIR has no points.jsonl, 4 if writing fails).
+    /// DIR/charts/ as PNG and SVG (exit 2 if DIR holds neither sweep records nor ensemble
+    /// contours, 4 if writing fails).
     Render(render_cmd::RenderArgs),
     /// Critical backward-whirl speed per friction coefficient (scan, then bisection).
     Critical(critical_cmd::CriticalArgs),
@@ -459,11 +460,12 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
     }
     if let (Some(path), Some(th)) = (&a.temperatures, &report.thermal) {
         let title = format!(
-            "{:.0} r/min, mu = {:.2}{}: touchdown bearing temperatures over {:.1} s",
+            "{:.0} r/min, mu = {:.2}{}: touchdown bearing temperatures over {} s",
             scene.speed_rpm,
             scene.mu_dynamic,
             settings_note(&scene),
-            report.end_time_s
+            // To the millisecond, without trailing zeros (60 s, 0.375 s).
+            (report.end_time_s * 1e3).round() / 1e3
         );
         draw_temperatures(path, &title, &th.series).map_err(|e| Failure::Output(e.into()))?;
     }
@@ -513,10 +515,19 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
     );
     outln!("  peak friction power   {:.1} W", f.peak_friction_power_w);
     outln!("  peak heat power       {:.1} W", f.peak_heat_power_w);
-    outln!(
-        "  whirl frequency       {:+.2} Hz (negative = against the spin)",
-        f.whirl_frequency_hz
-    );
+    // The same feature (the contact point's mean angular rate): a whirl frequency only when
+    // the orbit whirls; otherwise the contact point's slow drift.
+    if rec.class == whirlmap_sweep::classify::OrbitClass::BackwardWhirl {
+        outln!(
+            "  whirl frequency       {:+.2} Hz (negative = against the spin)",
+            f.whirl_frequency_hz
+        );
+    } else {
+        outln!(
+            "  contact point drift   {:+.2} Hz (the whirl-frequency feature; no whirl)",
+            f.whirl_frequency_hz
+        );
+    }
     outln!(
         "  contact point turns   {:+.2} since first touch, {:+.2} before settling, {:+.0} consecutive carried at the end",
         f.net_whirl_turns, f.transient_whirl_turns, f.whirl_streak_turns

@@ -120,7 +120,7 @@ fn a_life_sweep_writes_the_bearing_columns_and_charts() {
     // Whirl cells are in the charts' scales, described, not left out.
     let svg = std::fs::read_to_string(out_dir.join("charts/drops_to_failure.svg")).unwrap();
     assert!(svg.contains("whirl (hatched): the damage of the run up to its 5th whirl turn"));
-    assert!(!svg.contains("not in scale"));
+    assert!(!svg.contains("not in colour scale"));
 }
 
 #[test]

@@ -33,7 +33,9 @@ pub(crate) fn orbit_figure_size(n: usize) -> (u32, u32) {
     let (cols, rows) = panel_layout(n);
     let w = (cols as u32 * 420).max(1000);
     let h = TITLE_BAND + 44 + rows as u32 * if cols == 1 { 600 } else { 430 };
-    (w, h.max(700))
+    // A single row of square panels needs no more height than its panels (a floor of 700
+    // left the lower half of three panels empty).
+    (w, if rows == 1 && cols > 1 { h } else { h.max(700) })
 }
 
 impl Figure for OrbitPanels<'_> {

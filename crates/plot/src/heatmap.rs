@@ -373,18 +373,30 @@ impl Figure for GridFigure<'_> {
                         CONTOUR.mix(0.8).stroke_width(2),
                     ))?;
                 }
-                // Label the level once, on its longest segment, if that is 24 px or more.
-                let longest = segs.iter().max_by(|a, b| seg_px(a).total_cmp(&seg_px(b)));
-                let long_enough = |s: &&[(f64, f64); 2]| seg_px(s) >= 24.0;
-                if let Some(s) = longest.filter(long_enough) {
-                    let (p, q) = (px(s[0].0, s[0].1), px(s[1].0, s[1].1));
-                    boxed_text(
-                        &canvas,
-                        &m.label(*level),
-                        ((p.0 + q.0) / 2, (p.1 + q.1) / 2),
-                        13.0,
-                        CONTOUR,
-                    )?;
+                // Label each piece of the level (a level may cross the map in several
+                // separate lines) of 40 px or more, on its longest segment if that is 24 px
+                // or more.
+                let ends: Vec<[(i32, i32); 2]> = segs
+                    .iter()
+                    .map(|s| [px(s[0].0, s[0].1), px(s[1].0, s[1].1)])
+                    .collect();
+                for piece in connected_pieces(&ends) {
+                    let length: f64 = piece.iter().map(|&i| seg_px(&segs[i])).sum();
+                    let longest = piece
+                        .iter()
+                        .copied()
+                        .max_by(|&a, &b| seg_px(&segs[a]).total_cmp(&seg_px(&segs[b])));
+                    if let Some(i) = longest.filter(|&i| length >= 40.0 && seg_px(&segs[i]) >= 24.0)
+                    {
+                        let [p, q] = ends[i];
+                        boxed_text(
+                            &canvas,
+                            &m.label(*level),
+                            ((p.0 + q.0) / 2, (p.1 + q.1) / 2),
+                            13.0,
+                            CONTOUR,
+                        )?;
+                    }
                 }
             }
             if let Some((l, name, unit)) = limit {
@@ -465,13 +477,13 @@ impl Figure for GridFigure<'_> {
                     // The backward-whirl entry is always shown: it is where the scale stops.
                     entries.push((
                         Mark::Hatch(false),
-                        "backward whirl (not in scale)".to_string(),
+                        "backward whirl (not in colour scale)".to_string(),
                     ));
                 }
                 if whirl_seen[1] {
                     entries.push((
                         Mark::Hatch(true),
-                        "forward whirl (not in scale)".to_string(),
+                        "forward whirl (not in colour scale)".to_string(),
                     ));
                 }
                 if any_infinite {
@@ -485,7 +497,7 @@ impl Figure for GridFigure<'_> {
                 if any_unresolved {
                     entries.push((
                         Mark::Swatch(class_colour(OrbitClass::Unresolved)),
-                        "unresolved (not settled; not in scale)".to_string(),
+                        "unresolved (not settled; not in colour scale)".to_string(),
                     ));
                 }
                 if any_failed {
@@ -511,5 +523,67 @@ impl Figure for GridFigure<'_> {
             draw_colour_bar(&bar_area, &bar)?;
         }
         Ok(())
+    }
+}
+
+/// The connected pieces of a contour drawn as segments (end points in pixels): segments that
+/// share an end point belong to one piece. Each piece is the list of its segments' indices,
+/// in order of their first segment.
+fn connected_pieces(ends: &[[(i32, i32); 2]]) -> Vec<Vec<usize>> {
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut parent: Vec<usize> = (0..ends.len()).collect();
+    let mut first_at: std::collections::HashMap<(i32, i32), usize> =
+        std::collections::HashMap::new();
+    for (i, e) in ends.iter().enumerate() {
+        for point in e {
+            match first_at.get(point) {
+                Some(&j) => {
+                    let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                    parent[a.max(b)] = a.min(b);
+                }
+                None => {
+                    first_at.insert(*point, i);
+                }
+            }
+        }
+    }
+    let mut pieces: Vec<Vec<usize>> = Vec::new();
+    let mut index_of: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    for i in 0..ends.len() {
+        let r = root(&mut parent, i);
+        let k = *index_of.entry(r).or_insert_with(|| {
+            pieces.push(Vec::new());
+            pieces.len() - 1
+        });
+        pieces[k].push(i);
+    }
+    pieces
+}
+
+#[cfg(test)]
+mod tests {
+    use super::connected_pieces;
+
+    #[test]
+    fn segments_sharing_an_end_are_one_piece() {
+        // Two chains and a lone segment; the second chain's segments are given out of order.
+        let ends = [
+            [(0, 0), (1, 0)],
+            [(10, 10), (11, 10)],
+            [(1, 0), (2, 1)],
+            [(12, 11), (13, 11)],
+            [(11, 10), (12, 11)],
+            [(50, 50), (51, 51)],
+        ];
+        assert_eq!(
+            connected_pieces(&ends),
+            vec![vec![0, 2], vec![1, 3, 4], vec![5]]
+        );
     }
 }

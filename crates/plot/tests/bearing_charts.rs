@@ -121,7 +121,7 @@ fn bearing_charts_are_drawn_from_records_with_the_analysis() {
         "the whirl cell's value is said to cover 5 turns: {drops:?}"
     );
     assert!(
-        !drops.iter().any(|t| t.contains("not in scale")),
+        !drops.iter().any(|t| t.contains("not in colour scale")),
         "whirl cells are in the scale"
     );
     // Pressures of 1.4 to 2.2 GPa: the static limit is not reached, and the legend says so.

@@ -191,7 +191,7 @@ fn render_all_writes_every_chart_as_png_and_svg() {
                 "release speed (r/min)",
                 "friction coefficient",
                 "max contact force (N)",
-                "backward whirl (not in scale)",
+                "backward whirl (not in colour scale)",
             ],
         ),
         (
