@@ -369,7 +369,23 @@ fn build_scene_with(
     if let Some(v) = mu {
         scene.mu_dynamic = v;
     }
-    scene.validate()?;
+    scene.validate().map_err(|e| {
+        // A value given by a flag is named by the flag (and the field it sets).
+        let flag = match e.field.as_str() {
+            "mu_dynamic" if mu.is_some() => Some("--mu"),
+            "speed_rpm" if speed_rpm.is_some() => Some("--speed-rpm"),
+            _ => None,
+        };
+        match flag {
+            Some(flag) => anyhow::anyhow!(
+                "invalid {flag} = {} (the scene's {}): allowed {}",
+                e.value,
+                e.field,
+                e.allowed
+            ),
+            None => e.into(),
+        }
+    })?;
     Ok(scene)
 }
 

@@ -118,7 +118,7 @@ fn a_drop_that_has_not_settled_is_extended_until_its_class_is_decided() {
 #[test]
 fn bad_input_exits_2_naming_field_value_and_range() {
     let cases: &[(&[&str], &[&str])] = &[
-        (&["--mu", "2.5"], &["mu_dynamic", "2.5", "[0, 2]"]),
+        (&["--mu", "2.5"], &["--mu = 2.5", "mu_dynamic", "[0, 2]"]),
         (&["--mu", "-0.1"], &["mu_dynamic", "-0.1"]),
         (&["--mu", "NaN"], &["mu_dynamic", "NaN"]),
         (&["--duration-s", "0"], &["duration_s", "0", "(0, 3600]"]),
