@@ -19,18 +19,19 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
-use serde_json::Value;
 use whirlmap_core::{DropOptions, Fidelity, Scene, MODEL_VERSION};
 use whirlmap_sweep::critical::{check_mus, critical_rows, CriticalOptions};
-use whirlmap_sweep::overrides::apply;
+use whirlmap_sweep::overrides::apply_assignment;
 use whirlmap_sweep::recheck::recheck_bracket;
 use whirlmap_sweep::record::DropRecord;
 use whirlmap_sweep::run::{run_drop, DropFailure};
 use whirlmap_sweep::spec::{self, SweepSpec};
 use whirlmap_sweep::sweep::run_case;
 
+// Named `whirlmap.SimulationError`, where the package exports it, so that pickle (and with it
+// multiprocessing and joblib) finds the class again.
 pyo3::create_exception!(
-    _whirlmap,
+    whirlmap,
     SimulationError,
     PyRuntimeError,
     "A drop could not be integrated to its end: a typed solver error (its kind and the \
@@ -47,23 +48,43 @@ fn simulation_error(e: DropFailure) -> PyErr {
     SimulationError::new_err(format!("simulation failed ({}): {e}", e.kind()))
 }
 
-/// The rayon pool for `threads` (`None`: rayon's default).
+/// The most worker threads a call takes, as the command line's `--threads`.
+const MAX_THREADS: usize = 4096;
+
+/// The rayon pool for `threads` (`None`: rayon's default, which reads `RAYON_NUM_THREADS`).
+/// More than [`MAX_THREADS`], asked or from the environment, is refused: the pool is built
+/// before any drop, and a million threads never finished starting.
 fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
-    if threads == Some(0) {
-        return Err(value_error("invalid threads = 0: allowed >= 1 (or None)"));
+    if let Some(n) = threads.filter(|n| !(1..=MAX_THREADS).contains(n)) {
+        return Err(value_error(format!(
+            "invalid threads = {n}: allowed [1, {MAX_THREADS}] (or None)"
+        )));
+    }
+    if threads.is_none() {
+        for var in ["RAYON_NUM_THREADS", "RAYON_RS_NUM_CPUS"] {
+            let n = std::env::var(var)
+                .ok()
+                .and_then(|t| t.trim().parse::<usize>().ok());
+            if let Some(n) = n.filter(|n| *n > MAX_THREADS) {
+                return Err(value_error(format!(
+                    "{var} = {n}: allowed [1, {MAX_THREADS}] (0 or unset: one per core), or \
+                     pass threads"
+                )));
+            }
+        }
     }
     whirlmap_sweep::pool::pool(threads).map_err(|e| value_error(format!("threads: {e}")))
 }
 
-/// The paper's scene with `overrides` applied in order, each `(key, value as JSON text)`;
-/// a value that is not JSON is taken as a string, as `--set` takes it. An override error
-/// names the key and the value.
+/// The paper's scene with `overrides` applied in order, each `(key, value as JSON text)`,
+/// exactly as `--set key=value` applies it: a value that is not JSON is taken as a string,
+/// and `NaN` or `Infinity` is refused with the field's range. An override error names the key
+/// and the value.
 fn scene_with(overrides: &[(String, String)]) -> PyResult<Scene> {
     let mut scene = Scene::paper();
     for (key, text) in overrides {
-        let value: Value = serde_json::from_str(text.trim())
-            .unwrap_or_else(|_| Value::String(text.trim().to_string()));
-        apply(&mut scene, key, value).map_err(|e| value_error(format!("{key}={text}: {e}")))?;
+        apply_assignment(&mut scene, &format!("{key}={text}"))
+            .map_err(|e| value_error(format!("{key}={text}: {e}")))?;
     }
     Ok(scene)
 }

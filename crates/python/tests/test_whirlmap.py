@@ -251,3 +251,40 @@ def test_threads_run_drops_concurrently() -> None:
             )
         )
     assert threaded == serial
+
+
+def test_non_finite_values_are_refused_with_their_place() -> None:
+    with pytest.raises(ValueError, match=r"nan is not a finite number; allowed \[0, 2\]|NaN is not a finite number; allowed \[0, 2\]"):
+        whirlmap.drop(8000, None, mu_dynamic=float("nan"))
+    with pytest.raises(ValueError, match=r"Infinity is not a finite number; allowed \(0, 0\.1\] m"):
+        whirlmap.drop(8000, 0.3, clearance_m=float("inf"))
+    with pytest.raises(ValueError, match=r"invalid release_offset_m\[0\] = nan: allowed a finite number"):
+        whirlmap.drop(8000, 0.3, release_offset_m=[float("nan"), 0.0])
+    with pytest.raises(ValueError, match=r"invalid spec\.scene\.clearance_m = nan"):
+        whirlmap.sweep({**SPEC, "scene": {"clearance_m": float("nan")}})
+
+
+def test_options_are_checked_by_name() -> None:
+    for bad in (-1, 0, 10**6, 2.5, True):
+        with pytest.raises(ValueError, match="invalid threads"):
+            whirlmap.critical(0.4, from_rpm=2000, to_rpm=3000, threads=bad)
+    for bad in (-5, 0, 2.7):
+        with pytest.raises(ValueError, match="invalid series_points"):
+            whirlmap.drop(8000, 0.3, duration_s=0.01, series_points=bad)
+    with pytest.raises(ValueError, match="invalid series"):
+        whirlmap.drop(8000, 0.3, duration_s=0.01, series="no")
+    with pytest.raises(ValueError, match="invalid fidelity"):
+        whirlmap.drop(8000, 0.3, duration_s=0.01, fidelity=1)
+    with pytest.raises(ValueError, match="invalid speed_rpm = 1234"):
+        whirlmap.critical(0.4, from_rpm=2000, to_rpm=3000, speed_rpm=1234)
+
+
+def test_a_simulation_error_crosses_process_boundaries() -> None:
+    import pickle
+
+    with pytest.raises(whirlmap.SimulationError) as e:
+        whirlmap.drop(8000, 0.3, duration_s=0.01, solver__max_step_attempts=10)
+    back = pickle.loads(pickle.dumps(e.value))
+    assert type(back) is whirlmap.SimulationError
+    assert str(back) == str(e.value)
+    assert whirlmap.SimulationError.__module__ == "whirlmap"

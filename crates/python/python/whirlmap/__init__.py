@@ -28,7 +28,12 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _whirlmap
-from ._whirlmap import MODEL_VERSION, SimulationError
+from ._whirlmap import MODEL_VERSION as _MODEL_VERSION
+from ._whirlmap import SimulationError
+
+#: The model version of this build: a drop record's ``model_version`` (its results change only
+#: with it; docs/results-format.md).
+MODEL_VERSION: int = _MODEL_VERSION
 
 __all__ = [
     "DropResult",
@@ -92,12 +97,69 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"not a JSON value: {value!r}")
 
 
+def _nonfinite_path(value: Any, path: str) -> Optional[Tuple[str, Any]]:
+    """The first NaN or infinity in ``value`` (a JSON-like value), as (dotted path, value)."""
+    if isinstance(value, (float, np.floating)) and not np.isfinite(value):
+        return path, value
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, Mapping):
+        for key, inner in value.items():
+            found = _nonfinite_path(inner, f"{path}.{key}" if path else str(key))
+            if found:
+                return found
+    elif isinstance(value, (list, tuple)):
+        for i, inner in enumerate(value):
+            found = _nonfinite_path(inner, f"{path}[{i}]")
+            if found:
+                return found
+    return None
+
+
+def _json(value: Any, what: str) -> str:
+    """``value`` as JSON text; a NaN or infinity in it (JSON has neither) is a ``ValueError``
+    naming its place in ``what``."""
+    found = _nonfinite_path(value, "")
+    if found:
+        path, bad = found
+        place = f"{what}.{path}" if path and not path.startswith("[") else f"{what}{path}"
+        raise ValueError(f"invalid {place} = {bad}: allowed a finite number")
+    return json.dumps(value, default=_json_default, allow_nan=False)
+
+
 def _overrides(overrides: Mapping[str, Any]) -> List[Tuple[str, str]]:
-    """Scene overrides as ``(dotted key, value as JSON text)`` pairs, in the order given."""
-    return [
-        (key.replace("__", "."), json.dumps(value, default=_json_default))
-        for key, value in overrides.items()
-    ]
+    """Scene overrides as ``(dotted key, value as JSON text)`` pairs, in the order given. A
+    single non-finite number goes as ``NaN`` or ``Infinity``, which the scene refuses with the
+    field's range; one inside a list or dict is refused here, naming its place."""
+    pairs = []
+    for key, value in overrides.items():
+        dotted = key.replace("__", ".")
+        if isinstance(value, (float, np.floating)) and not np.isfinite(value):
+            pairs.append((dotted, json.dumps(float(value))))
+        else:
+            pairs.append((dotted, _json(value, dotted)))
+    return pairs
+
+
+def _threads(threads: Optional[int]) -> Optional[int]:
+    """``threads`` checked: ``None``, or a whole number in [1, 4096]."""
+    if threads is None:
+        return None
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
+        raise ValueError(f"invalid threads = {threads!r}: allowed a whole number in [1, 4096] or None")
+    if not 1 <= int(threads) <= 4096:
+        raise ValueError(f"invalid threads = {threads}: allowed [1, 4096] (or None)")
+    return int(threads)
+
+
+def _fidelity(fidelity: Optional[str]) -> Optional[str]:
+    """``fidelity`` checked to be ``None`` or a preset's name (the name itself is checked by
+    the engine)."""
+    if fidelity is not None and not isinstance(fidelity, str):
+        raise ValueError(
+            f"invalid fidelity = {fidelity!r}: allowed \"draft\", \"standard\", \"reference\" or None"
+        )
+    return fidelity
 
 
 def default_scene() -> Dict[str, Any]:
@@ -132,8 +194,12 @@ def drop(
             has not settled is extended (scene ``classification.max_extension_s``).
         fidelity: ``"draft"``, ``"standard"`` or ``"reference"``: the numerics preset;
             ``None``: the scene's own solver settings.
-        series: Record the time series (about ``series_points`` samples).
-        series_points: How many samples to keep, about, in [1, 1e7].
+        series: Record the time series (about ``series_points`` samples, at most one per
+            solver step).
+        series_points: How many samples to keep, at most, in [1, 1e7]: a sample is taken at
+            an accepted solver step at least ``duration_s / series_points`` after the last
+            one, so there are fewer when the steps are longer, and they are unevenly spaced
+            in time (resample before an FFT).
         **overrides: Scene parameters by their ``--set`` key: ``clearance_m=2e-4``,
             ``solver__rtol=1e-7`` (``__`` for each dot), ``friction_law="switched"``,
             ``release_offset_m=[1e-5, 0]``, ``thermal={}``.
@@ -147,11 +213,21 @@ def drop(
         SimulationError: The solver failed (its kind and the simulated time are in the
             message).
     """
+    if not isinstance(series, (bool, np.bool_)):
+        raise ValueError(f"invalid series = {series!r}: allowed True or False")
+    if series and (
+        isinstance(series_points, bool)
+        or not isinstance(series_points, (int, np.integer))
+        or not 1 <= int(series_points) <= 10_000_000
+    ):
+        raise ValueError(
+            f"invalid series_points = {series_points!r}: allowed a whole number in [1, 1e7]"
+        )
     record, scene, arrays, clearance_m = _whirlmap.drop(
         None if speed_rpm is None else float(speed_rpm),
         None if mu is None else float(mu),
         float(duration_s),
-        fidelity,
+        _fidelity(fidelity),
         int(series_points) if series else None,
         _overrides(overrides),
     )
@@ -213,6 +289,13 @@ def critical(
             value and allowed range); nothing has run.
     """
     mus = [float(mu)] if np.isscalar(mu) else [float(m) for m in mu]  # type: ignore[union-attr]
+    # The search sets the speed and the friction coefficient of every drop itself.
+    for key, by in (("speed_rpm", "from_rpm and to_rpm"), ("mu_dynamic", "mu")):
+        if key in overrides:
+            raise ValueError(
+                f"invalid {key} = {overrides[key]!r}: allowed no value here, {by} set it "
+                "for every drop of the search"
+            )
     text = _whirlmap.critical(
         mus,
         float(from_rpm),
@@ -220,9 +303,9 @@ def critical(
         float(resolution_rpm),
         float(tol_rpm),
         float(duration_s),
-        fidelity,
+        _fidelity(fidelity),
         _overrides(overrides),
-        threads,
+        _threads(threads),
     )
     rows: List[Dict[str, Any]] = json.loads(text)
     undecided = [
@@ -285,9 +368,9 @@ def sweep(
     if isinstance(spec, Mapping):
         spec_dict = dict(spec)
         spec_dict.setdefault("name", "python")
-        text = _whirlmap.sweep(json.dumps(spec_dict, default=_json_default), None, threads)
+        text = _whirlmap.sweep(_json(spec_dict, "spec"), None, _threads(threads))
     else:
-        text = _whirlmap.sweep(None, os.fspath(spec), threads)
+        text = _whirlmap.sweep(None, os.fspath(spec), _threads(threads))
     points = json.loads(text)
     if not flat:
         return points
