@@ -389,6 +389,15 @@ fn build_scene_with(
     Ok(scene)
 }
 
+/// `x` to three significant figures, without trailing zeros (60, 43.8, 0.375, 0.0004).
+fn three_figures(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let scale = 10f64.powi(2 - x.abs().log10().floor() as i32);
+    (x * scale).round() / scale
+}
+
 /// The scene's physical settings that differ from the paper's, for a chart title:
 /// `, unbalance_m 5e-6, support_damper radial_only` (the numerics, `solver.*` and
 /// `classification.*`, and the thermal model's parameters are left out; at most three, then
@@ -480,8 +489,7 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
             scene.speed_rpm,
             scene.mu_dynamic,
             settings_note(&scene),
-            // To the millisecond, without trailing zeros (60 s, 0.375 s).
-            (report.end_time_s * 1e3).round() / 1e3
+            three_figures(report.end_time_s)
         );
         draw_temperatures(path, &title, &th.series).map_err(|e| Failure::Output(e.into()))?;
     }
@@ -531,19 +539,22 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
     );
     outln!("  peak friction power   {:.1} W", f.peak_friction_power_w);
     outln!("  peak heat power       {:.1} W", f.peak_heat_power_w);
-    // The same feature (the contact point's mean angular rate): a whirl frequency only when
-    // the orbit whirls; otherwise the contact point's slow drift.
-    if rec.class == whirlmap_sweep::classify::OrbitClass::BackwardWhirl {
-        outln!(
-            "  whirl frequency       {:+.2} Hz (negative = against the spin)",
-            f.whirl_frequency_hz
-        );
-    } else {
-        outln!(
-            "  contact point drift   {:+.2} Hz (the whirl-frequency feature; no whirl)",
-            f.whirl_frequency_hz
-        );
-    }
+    // The same feature (the contact point's mean angular rate): a whirl frequency when the
+    // orbit whirls, the contact point's drift when it settled otherwise, its rate so far when
+    // it did not settle.
+    use whirlmap_sweep::classify::OrbitClass;
+    let (name, note) = match rec.class {
+        c if c.is_whirl() => ("whirl frequency      ", "negative = against the spin"),
+        OrbitClass::Unresolved => (
+            "contact point rate   ",
+            "the whirl-frequency feature; not settled",
+        ),
+        _ => (
+            "contact point drift  ",
+            "the whirl-frequency feature; no whirl",
+        ),
+    };
+    outln!("  {name} {:+.2} Hz ({note})", f.whirl_frequency_hz);
     outln!(
         "  contact point turns   {:+.2} since first touch, {:+.2} before settling, {:+.0} consecutive carried at the end",
         f.net_whirl_turns, f.transient_whirl_turns, f.whirl_streak_turns
@@ -651,17 +662,20 @@ fn check_thread_env(command: &Command) -> Result<(), Failure> {
     if !default_pool {
         return Ok(());
     }
+    // As rayon reads them: the first of the two that holds a whole number above 0 counts.
     for var in ["RAYON_NUM_THREADS", "RAYON_RS_NUM_CPUS"] {
-        let Ok(text) = std::env::var(var) else {
-            continue;
-        };
-        if let Ok(n) = text.trim().parse::<usize>() {
-            if n > MAX_THREADS {
+        let n = std::env::var(var)
+            .ok()
+            .and_then(|t| t.parse::<usize>().ok());
+        match n {
+            Some(n) if n > MAX_THREADS => {
                 return Err(Failure::Input(anyhow::anyhow!(
                     "{var} = {n}: allowed [1, {MAX_THREADS}] (0 or unset: one per core), or \
                      give --threads where the command has it"
                 )));
             }
+            Some(n) if n > 0 => return Ok(()),
+            _ => {}
         }
     }
     Ok(())

@@ -366,6 +366,8 @@ impl Figure for GridFigure<'_> {
                 .filter(|(_, segs)| segs.iter().map(seg_px).sum::<f64>() >= 30.0)
                 .collect();
             levels = contours.iter().map(|(level, _)| *level).collect();
+            // The labels placed so far: (centre, half size) in pixels.
+            let mut placed: Vec<((i32, i32), (i32, i32))> = Vec::new();
             for (level, segs) in &contours {
                 for s in segs {
                     canvas.draw(&PathElement::new(
@@ -374,29 +376,52 @@ impl Figure for GridFigure<'_> {
                     ))?;
                 }
                 // Label each piece of the level (a level may cross the map in several
-                // separate lines) of 40 px or more, on its longest segment if that is 24 px
-                // or more.
+                // separate lines) of 40 px or more, at the middle of its longest segment,
+                // unless the label would cover one already placed; a level keeps at least one
+                // label, on its longest piece, if that is 24 px or more.
                 let ends: Vec<[(i32, i32); 2]> = segs
                     .iter()
                     .map(|s| [px(s[0].0, s[0].1), px(s[1].0, s[1].1)])
                     .collect();
-                for piece in connected_pieces(&ends) {
-                    let length: f64 = piece.iter().map(|&i| seg_px(&segs[i])).sum();
-                    let longest = piece
-                        .iter()
-                        .copied()
-                        .max_by(|&a, &b| seg_px(&segs[a]).total_cmp(&seg_px(&segs[b])));
-                    if let Some(i) = longest.filter(|&i| length >= 40.0 && seg_px(&segs[i]) >= 24.0)
-                    {
-                        let [p, q] = ends[i];
-                        boxed_text(
-                            &canvas,
-                            &m.label(*level),
-                            ((p.0 + q.0) / 2, (p.1 + q.1) / 2),
-                            13.0,
-                            CONTOUR,
-                        )?;
+                // Each piece: its length and its segments, longest first (the places its
+                // label may go).
+                let mut pieces: Vec<(f64, Vec<usize>)> = connected_pieces(&ends)
+                    .into_iter()
+                    .map(|mut piece| {
+                        let length: f64 = piece.iter().map(|&i| seg_px(&segs[i])).sum();
+                        piece.sort_by(|&a, &b| seg_px(&segs[b]).total_cmp(&seg_px(&segs[a])));
+                        (length, piece)
+                    })
+                    .collect();
+                pieces.sort_by(|a, b| b.0.total_cmp(&a.0));
+                let text = m.label(*level);
+                // The label's half size, about (13 px type: 7 px a character).
+                let half = (text.len() as i32 * 7 / 2 + 4, 10);
+                let mut labelled = false;
+                for (k, (length, piece)) in pieces.iter().enumerate() {
+                    if !(*length >= 40.0 || (k == 0 && *length >= 24.0)) {
+                        continue;
                     }
+                    let mid = |i: usize| {
+                        let [p, q] = ends[i];
+                        ((p.0 + q.0) / 2, (p.1 + q.1) / 2)
+                    };
+                    let free = |at: (i32, i32)| {
+                        !placed.iter().any(|&(c, h): &((i32, i32), (i32, i32))| {
+                            (at.0 - c.0).abs() < half.0 + h.0 && (at.1 - c.1).abs() < half.1 + h.1
+                        })
+                    };
+                    // The middle of the longest segment that leaves the labels placed so far
+                    // clear; a level's first label goes on its longest segment regardless.
+                    let at = piece.iter().map(|&i| mid(i)).find(|&at| free(at));
+                    let at = match at {
+                        Some(at) => at,
+                        None if !labelled => mid(piece[0]),
+                        None => continue,
+                    };
+                    boxed_text(&canvas, &text, at, 13.0, CONTOUR)?;
+                    placed.push((at, half));
+                    labelled = true;
                 }
             }
             if let Some((l, name, unit)) = limit {

@@ -309,3 +309,56 @@ fn extreme_values_neither_panic_nor_hang() {
     assert_eq!(render_all(&dir).unwrap().len(), 10);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A field with two separate humps: every contour level crosses the map as two closed lines,
+/// and each line carries the level's label (the second one had none when a level was labelled
+/// once); the labels placed do not cover each other.
+#[test]
+fn each_separate_piece_of_a_contour_level_is_labelled() {
+    let dir = temp_dir("two-humps");
+    let (speeds, mus): (Vec<f64>, Vec<f64>) = (
+        (0..12).map(|i| 2000.0 + 2000.0 * i as f64).collect(),
+        (0..10).map(|j| 0.05 + 0.05 * j as f64).collect(),
+    );
+    let hump = |i: f64, j: f64, ci: f64, cj: f64| {
+        1000.0 * (-((i - ci).powi(2) + (j - cj).powi(2)) / 3.0).exp()
+    };
+    let mut lines = Vec::new();
+    for (j, &mu) in mus.iter().enumerate() {
+        for (i, &speed) in speeds.iter().enumerate() {
+            let (fi, fj) = (i as f64, j as f64);
+            let force = 900.0 + hump(fi, fj, 2.5, 2.5) + hump(fi, fj, 8.5, 6.5);
+            lines.push(
+                json!({"key": format!("p{}", lines.len()), "index": lines.len(),
+                       "inputs": {"speed_rpm": speed, "mu": mu}, "scene_hash": "abc",
+                       "duration_s": 1.0, "model_version": 1, "status": "ok",
+                       "record": {"class": "pendulum", "first_contact_force_n": force,
+                                  "max_contact_force_n": force,
+                                  "peak_friction_power_w": 100.0, "peak_heat_power_w": 100.0,
+                                  "whirl_frequency_hz": 0.0}})
+                .to_string(),
+            );
+        }
+    }
+    std::fs::write(dir.join("points.jsonl"), lines.join("\n") + "\n").unwrap();
+    render_all(&dir).unwrap();
+    let svg = std::fs::read_to_string(dir.join("charts/fig5_max_force.svg")).unwrap();
+    let texts: Vec<&str> = svg
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.starts_with('<'))
+        .collect();
+    // The contour labels are the texts that are levels and appear more than once (the colour
+    // bar's ticks appear once).
+    let count = |t: &str| texts.iter().filter(|x| **x == t).count();
+    let labelled: Vec<&str> = ["1200", "1400", "1600"]
+        .into_iter()
+        .filter(|t| count(t) >= 1)
+        .collect();
+    assert!(!labelled.is_empty(), "{texts:?}");
+    for t in labelled {
+        // The colour bar's tick, and one label on each hump's line.
+        assert_eq!(count(t), 3, "{t}: {texts:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

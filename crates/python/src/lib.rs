@@ -61,15 +61,20 @@ fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
         )));
     }
     if threads.is_none() {
+        // As rayon reads them: the first of the two that holds a whole number above 0 counts.
         for var in ["RAYON_NUM_THREADS", "RAYON_RS_NUM_CPUS"] {
-            let n = std::env::var(var)
+            match std::env::var(var)
                 .ok()
-                .and_then(|t| t.trim().parse::<usize>().ok());
-            if let Some(n) = n.filter(|n| *n > MAX_THREADS) {
-                return Err(value_error(format!(
-                    "{var} = {n}: allowed [1, {MAX_THREADS}] (0 or unset: one per core), or \
-                     pass threads"
-                )));
+                .and_then(|t| t.parse::<usize>().ok())
+            {
+                Some(n) if n > MAX_THREADS => {
+                    return Err(value_error(format!(
+                        "{var} = {n}: allowed [1, {MAX_THREADS}] (0 or unset: one per core), \
+                         or pass threads"
+                    )))
+                }
+                Some(n) if n > 0 => break,
+                _ => {}
             }
         }
     }

@@ -134,6 +134,8 @@ def _overrides(overrides: Mapping[str, Any]) -> List[Tuple[str, str]]:
     pairs = []
     for key, value in overrides.items():
         dotted = key.replace("__", ".")
+        if isinstance(value, np.ndarray) and value.ndim == 0:
+            value = value.item()
         if isinstance(value, (float, np.floating)) and not np.isfinite(value):
             pairs.append((dotted, json.dumps(float(value))))
         else:
@@ -194,12 +196,13 @@ def drop(
             has not settled is extended (scene ``classification.max_extension_s``).
         fidelity: ``"draft"``, ``"standard"`` or ``"reference"``: the numerics preset;
             ``None``: the scene's own solver settings.
-        series: Record the time series (about ``series_points`` samples, at most one per
-            solver step).
-        series_points: How many samples to keep, at most, in [1, 1e7]: a sample is taken at
+        series: Record the time series.
+        series_points: The series' density, a whole number in [1, 1e7]: a sample is taken at
             an accepted solver step at least ``duration_s / series_points`` after the last
-            one, so there are fewer when the steps are longer, and they are unevenly spaced
-            in time (resample before an FFT).
+            one. So about ``series_points`` samples cover the requested duration where the
+            steps are shorter than that spacing, fewer where they are longer, more when the
+            drop is extended for its class to settle; they are unevenly spaced in time
+            (resample before an FFT).
         **overrides: Scene parameters by their ``--set`` key: ``clearance_m=2e-4``,
             ``solver__rtol=1e-7`` (``__`` for each dot), ``friction_law="switched"``,
             ``release_offset_m=[1e-5, 0]``, ``thermal={}``.
@@ -213,12 +216,13 @@ def drop(
         SimulationError: The solver failed (its kind and the simulated time are in the
             message).
     """
-    if not isinstance(series, (bool, np.bool_)):
+    if series not in (True, False):
         raise ValueError(f"invalid series = {series!r}: allowed True or False")
+    whole = isinstance(series_points, (int, np.integer)) or (
+        isinstance(series_points, (float, np.floating)) and float(series_points).is_integer()
+    )
     if series and (
-        isinstance(series_points, bool)
-        or not isinstance(series_points, (int, np.integer))
-        or not 1 <= int(series_points) <= 10_000_000
+        isinstance(series_points, bool) or not whole or not 1 <= series_points <= 10_000_000
     ):
         raise ValueError(
             f"invalid series_points = {series_points!r}: allowed a whole number in [1, 1e7]"
@@ -267,8 +271,10 @@ def critical(
             ``resolution_rpm``.
         duration_s: Simulated time of each drop (s).
         fidelity: ``"draft"``, ``"standard"`` or ``"reference"``, or ``None``.
-        threads: Worker threads; ``None``: one per core (or ``RAYON_NUM_THREADS``).
-        **overrides: Scene parameters, as for :func:`drop`.
+        threads: Worker threads, in [1, 4096]; ``None``: one per core (or
+            ``RAYON_NUM_THREADS``).
+        **overrides: Scene parameters, as for :func:`drop`, but for ``speed_rpm`` and
+            ``mu_dynamic``, which the search sets for every drop (refused here).
 
     Returns:
         One dict per friction coefficient, in the order given: the ``CriticalRow`` schema
@@ -348,7 +354,8 @@ def sweep(
     Args:
         spec: A sweep spec (docs/sweeps.md) as a dict, or the path of a sweep JSON file. A
             dict may leave out ``name``.
-        threads: Worker threads; ``None``: one per core (or ``RAYON_NUM_THREADS``).
+        threads: Worker threads, in [1, 4096]; ``None``: one per core (or
+            ``RAYON_NUM_THREADS``).
         flat: Return flat rows (below); ``False``: the points' records as a sweep writes
             them to ``points.jsonl`` (nested dicts).
 
