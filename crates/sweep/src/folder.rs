@@ -850,6 +850,16 @@ pub fn relist_tree(dir: &Path, rel: &str) -> Result<(), SweepError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_studies_charts_are_owned_names() {
+        for stem in whirlmap_results::files::WORK_PRECISION_CHARTS {
+            for ext in ["png", "svg"] {
+                let name = format!("{stem}.{ext}");
+                assert!(OWNED.contains(&name.as_str()), "{name}");
+            }
+        }
+    }
     use serde_json::json;
 
     #[test]
