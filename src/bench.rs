@@ -130,7 +130,8 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             speed_rpm: 30_000.0,
             mu: 0.1,
             edit: |_| {},
-        }, // A tight study's two Rosenbrock methods, with the gap bound alone
+        },
+        // A tight study's two Rosenbrock methods, with the gap bound alone
         // (docs/accuracy.md#rodas5p-measured).
         Case {
             name: "pendulum 1 s, rodas4 rtol 1e-6, gap only",

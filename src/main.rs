@@ -645,12 +645,11 @@ fn main() -> ExitCode {
 }
 
 /// The most worker threads any command takes (`--threads`'s range).
-const MAX_THREADS: usize = 4096;
+const MAX_THREADS: usize = whirlmap_sweep::pool::MAX_THREADS;
 
-/// Refuses a thread count from the environment above [`MAX_THREADS`] (`RAYON_NUM_THREADS`,
-/// or the older `RAYON_RS_NUM_CPUS` that rayon also reads) for a command that takes rayon's
-/// default pool: one without `--threads` (99 999 threads ran out of memory before any work).
-/// Values rayon ignores (not a number) and 0 (one per core) pass.
+/// Refuses a thread count from the environment above [`MAX_THREADS`]
+/// ([`whirlmap_sweep::pool::env_threads_beyond_range`]) for a command that takes rayon's
+/// default pool: one without `--threads`.
 fn check_thread_env(command: &Command) -> Result<(), Failure> {
     let default_pool = match command {
         Command::Critical(_) | Command::Merge(_) | Command::Compare(_) | Command::Render(_) => true,
@@ -659,26 +658,12 @@ fn check_thread_env(command: &Command) -> Result<(), Failure> {
         Command::Adaptive(a) => a.common.threads.is_none(),
         _ => false,
     };
-    if !default_pool {
-        return Ok(());
+    match whirlmap_sweep::pool::env_threads_beyond_range() {
+        Some(e) if default_pool => Err(Failure::Input(anyhow::anyhow!(
+            "{e}, or give --threads where the command has it"
+        ))),
+        _ => Ok(()),
     }
-    // As rayon reads them: the first of the two that holds a whole number above 0 counts.
-    for var in ["RAYON_NUM_THREADS", "RAYON_RS_NUM_CPUS"] {
-        let n = std::env::var(var)
-            .ok()
-            .and_then(|t| t.parse::<usize>().ok());
-        match n {
-            Some(n) if n > MAX_THREADS => {
-                return Err(Failure::Input(anyhow::anyhow!(
-                    "{var} = {n}: allowed [1, {MAX_THREADS}] (0 or unset: one per core), or \
-                     give --threads where the command has it"
-                )));
-            }
-            Some(n) if n > 0 => return Ok(()),
-            _ => {}
-        }
-    }
-    Ok(())
 }
 
 /// Runs the command; returns its exit code.

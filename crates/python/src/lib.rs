@@ -48,8 +48,7 @@ fn simulation_error(e: DropFailure) -> PyErr {
     SimulationError::new_err(format!("simulation failed ({}): {e}", e.kind()))
 }
 
-/// The most worker threads a call takes, as the command line's `--threads`.
-const MAX_THREADS: usize = 4096;
+use whirlmap_sweep::pool::MAX_THREADS;
 
 /// The rayon pool for `threads` (`None`: rayon's default, which reads `RAYON_NUM_THREADS`).
 /// More than [`MAX_THREADS`], asked or from the environment, is refused: the pool is built
@@ -60,23 +59,12 @@ fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
             "invalid threads = {n}: allowed [1, {MAX_THREADS}] (or None)"
         )));
     }
-    if threads.is_none() {
-        // As rayon reads them: the first of the two that holds a whole number above 0 counts.
-        for var in ["RAYON_NUM_THREADS", "RAYON_RS_NUM_CPUS"] {
-            match std::env::var(var)
-                .ok()
-                .and_then(|t| t.parse::<usize>().ok())
-            {
-                Some(n) if n > MAX_THREADS => {
-                    return Err(value_error(format!(
-                        "{var} = {n}: allowed [1, {MAX_THREADS}] (0 or unset: one per core), \
-                         or pass threads"
-                    )))
-                }
-                Some(n) if n > 0 => break,
-                _ => {}
-            }
-        }
+    if let Some(e) = threads
+        .is_none()
+        .then(whirlmap_sweep::pool::env_threads_beyond_range)
+        .flatten()
+    {
+        return Err(value_error(format!("{e}, or pass threads")));
     }
     whirlmap_sweep::pool::pool(threads).map_err(|e| value_error(format!("threads: {e}")))
 }
