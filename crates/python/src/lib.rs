@@ -11,16 +11,20 @@
 //!
 //! Records cross the boundary as JSON text (parsed by the Python layer), so every field the
 //! records gain reaches Python unchanged; time series cross as NumPy arrays. Every
-//! simulation runs with the GIL released, so Python threads run drops concurrently.
+//! simulation runs with the GIL released, so Python threads run drops concurrently; a
+//! search and a sweep stop at Ctrl-C (the drops not yet started are skipped, through
+//! [`whirlmap_sweep::cancel`]).
 #![warn(missing_docs)]
 
 use numpy::IntoPyArray;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
+use std::time::Duration;
 use whirlmap_core::{DropOptions, Fidelity, Scene, MODEL_VERSION};
-use whirlmap_sweep::critical::{check_mus, critical_rows, CriticalOptions};
+use whirlmap_sweep::cancel::Cancel;
+use whirlmap_sweep::critical::{check_mus, critical_rows_cancellable, CriticalOptions};
 use whirlmap_sweep::overrides::apply_assignment;
 use whirlmap_sweep::recheck::recheck_bracket;
 use whirlmap_sweep::record::DropRecord;
@@ -49,6 +53,57 @@ fn simulation_error(e: DropFailure) -> PyErr {
 }
 
 use whirlmap_sweep::pool::MAX_THREADS;
+
+/// Runs `work` on its own thread, in `pool`, with the GIL released, while the calling thread
+/// checks for a signal (Ctrl-C, a notebook's "interrupt kernel") every tenth of a second.
+/// On an interrupt, `cancel` is raised, so the drops not yet started are skipped; the call
+/// waits for the running ones and raises `KeyboardInterrupt` with `interrupted(n)` as its
+/// message, `n` the drops counted on `cancel`. Another exception from a signal handler is
+/// raised as it is.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    pool: &rayon::ThreadPool,
+    cancel: &Cancel,
+    interrupted: impl Fn(usize) -> String,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    std::thread::scope(|scope| {
+        let (done_tx, done_rx) = std::sync::mpsc::channel();
+        let worker = scope.spawn(move || {
+            let out = pool.install(work);
+            // The receiver lives until the worker is joined.
+            let _ = done_tx.send(());
+            out
+        });
+        let join = |w: std::thread::ScopedJoinHandle<'_, T>| {
+            w.join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+        };
+        let mut done_rx = done_rx;
+        loop {
+            // Moved in and back out: a `Receiver` is `Send`, not `Sync`.
+            let (wait, rx) = py.detach(move || {
+                let wait = done_rx.recv_timeout(Duration::from_millis(100));
+                (wait, done_rx)
+            });
+            done_rx = rx;
+            // Disconnected: the worker ended without sending (a panic, raised by the join).
+            if !matches!(wait, Err(std::sync::mpsc::RecvTimeoutError::Timeout)) {
+                return Ok(py.detach(|| join(worker)));
+            }
+            if let Err(e) = py.check_signals() {
+                cancel.request();
+                py.detach(|| join(worker));
+                if !e.is_instance_of::<PyKeyboardInterrupt>(py) {
+                    return Err(e);
+                }
+                return Err(PyKeyboardInterrupt::new_err(interrupted(
+                    cancel.drops_run(),
+                )));
+            }
+        }
+    })
+}
 
 /// The rayon pool for `threads` (`None`: rayon's default, which reads `RAYON_NUM_THREADS`).
 /// More than [`MAX_THREADS`], asked or from the environment, is refused: the pool is built
@@ -202,24 +257,36 @@ fn critical(
             .map_err(|e| value_error(format!("with mu {mu}: {e}")))?;
     }
     let pool = pool(threads)?;
-    let rows = py.detach(|| {
-        pool.install(|| {
-            let mut rows = critical_rows(&base, &mus, &opts)?;
-            if let Some(tighter) = preset.and_then(|f| f.tighter()) {
-                let drop_opts = DropOptions {
-                    duration_s,
-                    ..Default::default()
-                };
-                for row in rows.iter_mut() {
-                    let mut s = base.clone();
-                    s.mu_dynamic = row.mu;
-                    row.recheck = recheck_bracket(&s, row, tighter, &drop_opts);
+    let cancel = Cancel::new();
+    let scan = mus.len() * opts.scan_speeds().len();
+    let interrupted = |n| {
+        format!(
+            "critical search interrupted after {n} drops (its scan has {scan}, then \
+             bisections); nothing is returned"
+        )
+    };
+    let rows = interruptible(py, &pool, &cancel, interrupted, || {
+        let Some(mut rows) = critical_rows_cancellable(&base, &mus, &opts, &cancel)? else {
+            return Ok(None);
+        };
+        if let Some(tighter) = preset.and_then(|f| f.tighter()) {
+            let drop_opts = DropOptions {
+                duration_s,
+                ..Default::default()
+            };
+            for row in rows.iter_mut() {
+                if cancel.requested() {
+                    return Ok(None);
                 }
+                let mut s = base.clone();
+                s.mu_dynamic = row.mu;
+                row.recheck = recheck_bracket(&s, row, tighter, &drop_opts);
             }
-            Ok::<_, whirlmap_core::InvalidParameter>(rows)
-        })
-    });
-    let rows = rows.map_err(value_error)?;
+        }
+        Ok::<_, whirlmap_core::InvalidParameter>(Some(rows))
+    })?;
+    // `None` only after a cancel, which `interruptible` has raised already.
+    let rows = rows.map_err(value_error)?.unwrap_or_default();
     Ok(serde_json::to_string(&rows).expect("rows serialise"))
 }
 
@@ -248,17 +315,26 @@ fn sweep(
     spec.check_points().map_err(value_error)?;
     let grid = spec.grid().map_err(value_error)?;
     let pool = pool(threads)?;
-    let records = py.detach(|| {
-        pool.install(|| {
-            (0..grid.len())
-                .into_par_iter()
-                .map(|i| {
-                    let point = grid.point(i).expect("every point was checked");
-                    run_case(&point, spec.duration_s)
-                })
-                .collect::<Vec<_>>()
-        })
-    });
+    let cancel = Cancel::new();
+    let total = grid.len();
+    let interrupted =
+        |n| format!("sweep interrupted: {n} of {total} points had run; nothing is returned");
+    let records = interruptible(py, &pool, &cancel, interrupted, || {
+        (0..grid.len())
+            .into_par_iter()
+            .map(|i| {
+                if cancel.requested() {
+                    return None;
+                }
+                let point = grid.point(i).expect("every point was checked");
+                let record = run_case(&point, spec.duration_s);
+                cancel.count_drop();
+                Some(record)
+            })
+            .collect::<Option<Vec<_>>>()
+    })?;
+    // `None` only after a cancel, which `interruptible` has raised already.
+    let records = records.unwrap_or_default();
     Ok(serde_json::to_string(&records).expect("records serialise"))
 }
 

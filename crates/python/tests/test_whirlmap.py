@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
+import os
+import re
+import signal
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 import pytest
@@ -288,3 +294,48 @@ def test_a_simulation_error_crosses_process_boundaries() -> None:
     assert type(back) is whirlmap.SimulationError
     assert str(back) == str(e.value)
     assert whirlmap.SimulationError.__module__ == "whirlmap"
+
+
+@contextlib.contextmanager
+def _interrupt_after(seconds: float) -> Iterator[None]:
+    """A SIGINT to this process after `seconds`, as Ctrl-C in a terminal sends it; never
+    later than the block."""
+    timer = threading.Timer(seconds, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+        timer.join()
+
+
+def test_ctrl_c_stops_a_sweep_before_its_end() -> None:
+    # 2000 one-second drops on one thread: tens of seconds, where the interrupt comes after
+    # half a second. Without it reaching the engine, the call would return every record
+    # and the interrupt would arrive only then, without the count.
+    speeds = list(range(2000, 12000, 5))
+    spec = {"duration_s": 1.0, "axes": {"speed_rpm": speeds, "mu": [0.1]}}
+    with pytest.raises(KeyboardInterrupt) as info, _interrupt_after(0.5):
+        whirlmap.sweep(spec, threads=1)
+    m = re.fullmatch(
+        r"sweep interrupted: (\d+) of 2000 points had run; nothing is returned",
+        str(info.value),
+    )
+    assert m is not None, str(info.value)
+    assert int(m.group(1)) < 2000
+    # The next call runs as usual.
+    assert len(whirlmap.sweep(SPEC, threads=1)) == 6
+
+
+def test_ctrl_c_stops_a_critical_search_before_its_end() -> None:
+    with pytest.raises(KeyboardInterrupt) as info, _interrupt_after(0.5):
+        whirlmap.critical(
+            [0.1, 0.2, 0.3, 0.4], from_rpm=1000, to_rpm=30000, resolution_rpm=50, threads=1
+        )
+    m = re.fullmatch(
+        r"critical search interrupted after (\d+) drops \(its scan has (\d+), then "
+        r"bisections\); nothing is returned",
+        str(info.value),
+    )
+    assert m is not None, str(info.value)
+    assert int(m.group(1)) < int(m.group(2)) == 4 * 581

@@ -630,6 +630,31 @@ pub fn critical_rows_logged(
     ticker: &Ticker,
     log: Option<&crate::critical_log::DropLog>,
 ) -> Result<Vec<CriticalRow>, InvalidParameter> {
+    rows_inner(base, mus, o, ticker, log, None)
+}
+
+/// [`critical_rows`] that stops early when `cancel` is raised: the drops not yet started are
+/// skipped (their probes fail as "cancelled"), so the search ends once the running drops
+/// have. `None` then, since such rows are not the search's; otherwise the rows of
+/// [`critical_rows`]. Every drop that ran is counted on `cancel`.
+pub fn critical_rows_cancellable(
+    base: &Scene,
+    mus: &[f64],
+    o: &CriticalOptions,
+    cancel: &crate::cancel::Cancel,
+) -> Result<Option<Vec<CriticalRow>>, InvalidParameter> {
+    let rows = rows_inner(base, mus, o, &Ticker::off(), None, Some(cancel))?;
+    Ok((!cancel.requested()).then_some(rows))
+}
+
+fn rows_inner(
+    base: &Scene,
+    mus: &[f64],
+    o: &CriticalOptions,
+    ticker: &Ticker,
+    log: Option<&crate::critical_log::DropLog>,
+    cancel: Option<&crate::cancel::Cancel>,
+) -> Result<Vec<CriticalRow>, InvalidParameter> {
     check_mus(mus)?;
     o.validate()?;
     ticker.expect_more(mus.len() * o.scan_speeds().len());
@@ -652,10 +677,16 @@ pub fn critical_rows_logged(
     let results = search_all(
         |j, speed| {
             let (mu, hash) = (mus[j], &hashes[j]);
+            if cancel.is_some_and(|c| c.requested()) {
+                return Outcome::Failed("cancelled".to_owned());
+            }
             let outcome = match log.and_then(|l| l.known(mu, speed, hash)) {
                 Some(class) => Outcome::Class(class),
                 None => {
                     let outcome = drop_outcome(&scenes[j], speed, &drop_opts);
+                    if let Some(c) = cancel {
+                        c.count_drop();
+                    }
                     if let (Some(l), Outcome::Class(class)) = (log, &outcome) {
                         l.record(mu, speed, hash, *class);
                     }
@@ -1054,5 +1085,30 @@ mod tests {
         let json = serde_json::to_string(&one).unwrap();
         let back: Vec<CriticalRow> = serde_json::from_str(&json).unwrap();
         assert_eq!(back, one);
+    }
+
+    #[test]
+    fn a_cancelled_search_runs_no_further_drop_and_an_uncancelled_one_gives_the_rows() {
+        let o = CriticalOptions {
+            from_rpm: 4000.0,
+            to_rpm: 5000.0,
+            resolution_rpm: 500.0,
+            tol_rpm: 250.0,
+            duration_s: 0.05,
+        };
+        let scene = Scene::paper();
+        let cancel = crate::cancel::Cancel::new();
+        let rows = critical_rows_cancellable(&scene, &[0.4], &o, &cancel).unwrap();
+        let plain = critical_rows(&scene, &[0.4], &o).unwrap();
+        assert_eq!(rows.as_ref(), Some(&plain));
+        assert_eq!(cancel.drops_run(), plain[0].drops);
+
+        let cancel = crate::cancel::Cancel::new();
+        cancel.request();
+        assert_eq!(
+            critical_rows_cancellable(&scene, &[0.4], &o, &cancel).unwrap(),
+            None
+        );
+        assert_eq!(cancel.drops_run(), 0);
     }
 }

@@ -13,6 +13,7 @@
 //!   sweep's grid runs).
 //! - [`shard`] and [`merge`]: a sweep split over machines and joined again.
 //! - [`compare`]: what changed between two results (nightly jobs).
+//! - [`cancel`]: a stop request for a running search or grid (the Python package's Ctrl-C).
 //! - [`accuracy`]: the work-precision study (`whirlmap accuracy`).
 //! - [`ensemble`]: whirl probability per cell (seeded ensembles of drops), probability
 //!   contours; [`adaptive`]: adaptive refinement of the whirl boundary;
@@ -30,6 +31,7 @@ pub mod accuracy;
 pub mod adaptive;
 pub mod adaptive_log;
 pub mod build_info;
+pub mod cancel;
 pub mod classify;
 pub mod compare;
 pub mod critical;
