@@ -11,7 +11,7 @@ use crate::axes::{MU_DESC, SPEED_DESC};
 use crate::colour_bar::{draw_colour_bar, scale_colour, ColourBar};
 use crate::contour::{marching_squares, nice_levels};
 use crate::marks::{
-    boxed_text, class_colour, cross, hatch, hatch_in, legend, Mark, ALL_CLASSES, CONTOUR,
+    boxed_text, class_colour, cross, drop_dot, hatch, hatch_in, legend, Mark, ALL_CLASSES, CONTOUR,
     FAILED_BG, LIMIT, WHIRL_BG, WHIRL_OVER,
 };
 use crate::render::{
@@ -40,6 +40,17 @@ pub(crate) fn edges(centres: &[f64]) -> Vec<f64> {
             e
         }
     }
+}
+
+/// Whether increasing centres are unevenly spaced (three or more, steps differing by more
+/// than one part in a million): then a cell reaches halfway to each neighbour and its drop
+/// is not at its middle, so the chart marks where the drops were.
+pub(crate) fn uneven(centres: &[f64]) -> bool {
+    let steps: Vec<f64> = centres.windows(2).map(|w| w[1] - w[0]).collect();
+    let (lo, hi) = steps.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &d| {
+        (lo.min(d), hi.max(d))
+    });
+    steps.len() >= 2 && hi - lo > 1e-6 * hi
 }
 
 pub(crate) fn with_slice(title: &str, slice: &Option<String>) -> String {
@@ -219,11 +230,13 @@ impl Figure for GridFigure<'_> {
 
         let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (bw, bh) = body.dim_in_pixel();
+        // On an uneven grid, a dot marks where each drop was, and the legend says so.
+        let drops_marked = uneven(&g.speeds_rpm) || uneven(&g.mus);
         let legend_h = if self.whirl_label.is_some() || limit.is_some() {
             66
         } else {
             44
-        };
+        } + if drops_marked { 22 } else { 0 };
         let (main, legend_band) = body.split_vertically(bh.saturating_sub(legend_h));
         let (plot_area, bar_area) = if is_metric {
             main.split_horizontally(bw.saturating_sub(150))
@@ -314,6 +327,17 @@ impl Figure for GridFigure<'_> {
                         [(tl.0 + k, tl.1 + k), (br.0 - k, br.1 - k)],
                         BLACK.stroke_width(1),
                     ))?;
+                }
+            }
+        }
+
+        // The drops' dots go under the contours and their labels.
+        if drops_marked {
+            for j in 0..ny {
+                for i in 0..nx {
+                    if kinds[j * nx + i] != CellKind::Empty {
+                        drop_dot(&canvas, px(g.speeds_rpm[i], g.mus[j]))?;
+                    }
                 }
             }
         }
@@ -533,6 +557,9 @@ impl Figure for GridFigure<'_> {
         if any_empty {
             entries.push((Mark::Swatch(WHITE), "no data".to_string()));
         }
+        if drops_marked {
+            entries.push((Mark::Drop, "drop (uneven grid)".to_string()));
+        }
         legend(&legend_band, &entries)?;
 
         if let (Some(m), Some((lo, hi))) = (metric, scale) {
@@ -593,7 +620,22 @@ fn connected_pieces(ends: &[[(i32, i32); 2]]) -> Vec<Vec<usize>> {
 
 #[cfg(test)]
 mod tests {
-    use super::connected_pieces;
+    use super::{connected_pieces, uneven};
+
+    #[test]
+    fn uneven_spacing_is_told_from_rounding() {
+        assert!(uneven(&[2000.0, 3000.0, 5000.0]));
+        assert!(uneven(&[0.05, 0.1, 0.15, 0.2, 0.3]));
+        assert!(
+            !uneven(&[0.1, 0.15, 0.2, 0.25, 0.3]),
+            "steps differing in rounding"
+        );
+        let built: Vec<f64> = (0..11)
+            .map(|k| 0.1 + k as f64 * (0.4 - 0.1) / 10.0)
+            .collect();
+        assert!(!uneven(&built));
+        assert!(!uneven(&[1.0, 2.0]) && !uneven(&[1.0]) && !uneven(&[]));
+    }
 
     #[test]
     fn segments_sharing_an_end_are_one_piece() {

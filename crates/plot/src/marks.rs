@@ -72,6 +72,18 @@ pub enum Mark {
     ArrowDown(RGBColor),
     /// An open circle.
     OpenDot(RGBColor),
+    /// Where a drop was, on a grid of uneven cells ([`drop_dot`]).
+    Drop,
+}
+
+/// A drop's place on a grid chart: a small dark dot ringed in white, seen on every cell
+/// colour.
+pub(crate) fn drop_dot<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    at: (i32, i32),
+) -> DrawResult<DB> {
+    area.draw(&Circle::new(at, 4, WHITE.filled()))?;
+    area.draw(&Circle::new(at, 3, RGBColor(30, 30, 30).filled()))
 }
 
 /// Draws hatch lines (45 degrees; the other diagonal if `forward`) in a pixel rectangle.
@@ -255,6 +267,7 @@ pub(crate) fn draw_mark<DB: DrawingBackend>(
         Mark::TriangleUp(c) => triangle_up(area, (x + mark_w / 2, y), 7, c)?,
         Mark::ArrowUp(c) => arrow(area, (x + mark_w / 2, y + 9), true, c)?,
         Mark::ArrowDown(c) => arrow(area, (x + mark_w / 2, y - 9), false, c)?,
+        Mark::Drop => drop_dot(area, (x + mark_w / 2, y))?,
         Mark::OpenDot(c) => {
             area.draw(&Circle::new((x + mark_w / 2, y), 5, WHITE.filled()))?;
             area.draw(&Circle::new((x + mark_w / 2, y), 5, c.stroke_width(2)))?;

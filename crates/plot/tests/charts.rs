@@ -192,6 +192,8 @@ fn render_all_writes_every_chart_as_png_and_svg() {
                 "friction coefficient",
                 "max contact force (N)",
                 "backward whirl (not in colour scale)",
+                // MUS step 0.05, then 0.1: the drops are marked.
+                "drop (uneven grid)",
             ],
         ),
         (
@@ -360,5 +362,7 @@ fn each_separate_piece_of_a_contour_level_is_labelled() {
         // The colour bar's tick, and one label on each hump's line.
         assert_eq!(count(t), 3, "{t}: {texts:?}");
     }
+    // An even grid: each drop is at its cell's middle, and nothing marks it.
+    assert!(!svg.contains("drop (uneven grid)"));
     let _ = std::fs::remove_dir_all(&dir);
 }
