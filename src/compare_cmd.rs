@@ -41,12 +41,9 @@ pub fn run(a: &CompareArgs) -> CmdResult {
         errln!("warning: {w}");
     }
     outln!(
-        "compare: {}: {} of {} points and {} of {} critical speeds changed{}",
+        "compare: {}: {}{}",
         if c.changed() { "CHANGED" } else { "same" },
-        c.points.len(),
-        c.points_compared,
-        c.critical.len(),
-        c.critical_compared,
+        c.counts(),
         if c.spec_differences.is_empty() {
             ""
         } else {

@@ -233,3 +233,33 @@ fn nightly_script_reproduces_the_committed_baseline() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Grids that overlap in part: the points in one run only are counted apart from the points
+/// compared (the summary said "4 of 2 points changed" before).
+#[test]
+fn points_in_one_run_only_are_counted_apart_from_those_compared() {
+    let dir = temp_dir("overlap-grids");
+    let base = sweep(SPEC, &dir, "base");
+    let other = SPEC.replace("[4000, 8000]", "[4000, 6000]");
+    let new = sweep(&other, &dir, "new");
+    let report = dir.join("partial.md");
+    let o = whirlmap(&["compare", s(&base), s(&new), "--out", s(&report)]);
+    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    assert!(
+        out(&o).contains(
+            "compare: CHANGED: 0 of 2 points and 0 of 0 critical speeds changed; \
+             in one run only: 4 points, 0 critical speeds"
+        ),
+        "{}",
+        out(&o)
+    );
+    let md = std::fs::read_to_string(&report).unwrap();
+    assert!(
+        md.contains(
+            "**CHANGED**: 0 of 2 points and 0 of 0 critical speeds changed beyond the \
+             thresholds; in one run only: 4 points, 0 critical speeds"
+        ),
+        "{md}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -74,6 +74,8 @@ pub struct PointChange {
     pub what: Vec<String>,
     /// The point in the new run (`None` if it is only in the baseline).
     pub new_row: Option<PointRow>,
+    /// The point is in one run only (not one of the points compared).
+    pub in_one_run: bool,
 }
 
 /// One friction coefficient whose critical speed moved.
@@ -87,6 +89,8 @@ pub struct CriticalChange {
     pub new: Option<[f64; 2]>,
     /// In words.
     pub what: String,
+    /// Searched in one run only (not one of the searches compared).
+    pub in_one_run: bool,
 }
 
 /// The findings of a comparison.
@@ -124,6 +128,33 @@ impl Comparison {
     /// Whether anything changed beyond the thresholds.
     pub fn changed(&self) -> bool {
         !self.points.is_empty() || !self.critical.is_empty()
+    }
+
+    /// The counts in words: `3 of 64 points and 0 of 5 critical speeds changed`, then, when
+    /// some are in one run only, `; in one run only: 2 points, 1 critical speed`. A point
+    /// or search in one run only counts as a change, but not among those compared.
+    pub fn counts(&self) -> String {
+        let one = |n: usize, what: &str| match n {
+            1 => format!("1 {what}"),
+            n => format!("{n} {what}s"),
+        };
+        let pts_one = self.points.iter().filter(|p| p.in_one_run).count();
+        let crit_one = self.critical.iter().filter(|c| c.in_one_run).count();
+        let mut s = format!(
+            "{} of {} points and {} of {} critical speeds changed",
+            self.points.len() - pts_one,
+            self.points_compared,
+            self.critical.len() - crit_one,
+            self.critical_compared
+        );
+        if pts_one + crit_one > 0 {
+            s.push_str(&format!(
+                "; in one run only: {}, {}",
+                one(pts_one, "point"),
+                one(crit_one, "critical speed")
+            ));
+        }
+        s
     }
 }
 
@@ -245,6 +276,7 @@ fn compare_critical(base: &[CriticalRow], new: &[CriticalRow]) -> (usize, Vec<Cr
                 baseline: None,
                 new: n.bracket_rpm,
                 what: "searched in the new run only".into(),
+                in_one_run: true,
             });
             continue;
         };
@@ -277,6 +309,7 @@ fn compare_critical(base: &[CriticalRow], new: &[CriticalRow]) -> (usize, Vec<Cr
                 baseline: bb,
                 new: nb,
                 what,
+                in_one_run: false,
             });
         }
     }
@@ -287,6 +320,7 @@ fn compare_critical(base: &[CriticalRow], new: &[CriticalRow]) -> (usize, Vec<Cr
                 baseline: b.bracket_rpm,
                 new: None,
                 what: "searched in the baseline only".into(),
+                in_one_run: true,
             });
         }
     }
@@ -396,6 +430,7 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
                 inputs: inputs_text(n),
                 what,
                 new_row: Some(n.clone()),
+                in_one_run: !base_by.contains_key(&key),
             });
         }
     }
@@ -405,6 +440,7 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
                 inputs: inputs_text(b),
                 what: vec!["not in the new run".to_string()],
                 new_row: None,
+                in_one_run: true,
             });
         }
     }
@@ -591,12 +627,10 @@ pub fn write_report(
     let _ = writeln!(md, "# whirlmap compare\n");
     let _ = writeln!(
         md,
-        "**{}**: {} of {} points and {} of {} critical speeds changed beyond the thresholds{}.\n",
+        "**{}**: {}{}.\n",
         if c.changed() { "CHANGED" } else { "SAME" },
-        c.points.len(),
-        c.points_compared,
-        c.critical.len(),
-        c.critical_compared,
+        c.counts()
+            .replacen(" changed", " changed beyond the thresholds", 1),
         if c.spec_differences.is_empty() {
             ""
         } else {
