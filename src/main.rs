@@ -668,7 +668,21 @@ fn check_thread_env(command: &Command) -> Result<(), Failure> {
 
 /// Runs the command; returns its exit code.
 fn run() -> u8 {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // A usage error (exit 2), or `--help` and `--version` (exit 0, and exit 4 when they
+        // cannot be written, `whirlmap --help > /dev/full`, but not for a closed pipe, as
+        // `output` says), in clap's words.
+        Err(e) => {
+            return match e.print() {
+                Err(cause) if !e.use_stderr() && cause.kind() != std::io::ErrorKind::BrokenPipe => {
+                    errln!("error: cannot write standard output: {cause}");
+                    4
+                }
+                _ => e.exit_code() as u8,
+            };
+        }
+    };
     if let Err(f) = check_thread_env(&cli.command) {
         errln!("error: {:#}", f.error());
         return f.code();

@@ -91,6 +91,31 @@ fn closed_stdout(args: &[&str]) -> std::process::Output {
     child.wait_with_output().unwrap()
 }
 
+/// Help and version that cannot be written (a full disk behind `>`) exit 4, as every other
+/// output that cannot be written does; a usage error keeps its exit 2.
+#[test]
+fn help_that_cannot_be_written_is_not_exit_0() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        return; // not on this system
+    };
+    for args in [&["--help"][..], &["sweep", "--help"], &["--version"]] {
+        let o = Command::new(BIN)
+            .args(args)
+            .stdout(full.try_clone().unwrap())
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(4), "{args:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("cannot write standard output"),
+            "{}",
+            stderr(&o)
+        );
+    }
+    let o = whirlmap(&["no-such-command"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
 /// The commit `whirlmap --version` names.
 fn built_commit() -> String {
     let o = whirlmap(&["--version"]);
@@ -632,6 +657,16 @@ fn critical_ranges_are_checked_before_any_drop_and_named_readably() {
 
 #[test]
 fn a_closed_stdout_ends_quietly_and_the_work_is_finished() {
+    for args in [
+        &["scene"][..],
+        &["--help"],
+        &["drop", "--help"],
+        &["--version"],
+    ] {
+        let o = closed_stdout(args);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).is_empty(), "{args:?}: {}", stderr(&o));
+    }
     let o = closed_stdout(&["scene"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
