@@ -41,7 +41,14 @@ fn same_seed_same_bytes_for_one_and_two_threads() {
         assert_eq!(x, read(&c.join(f)), "{f}: a second run");
     }
     assert!(a.join("charts/fig4_probability.png").exists());
-    assert!(a.join("charts/fig4_probability.svg").exists());
+    let svg = read(&a.join("charts/fig4_probability.svg"));
+    for words in [
+        "cell P(whirl)",
+        "open where they leave the range",
+        "P(whirl) = 50 %",
+    ] {
+        assert!(svg.contains(words), "the legend lacks {words:?}");
+    }
 
     // The statistics agree with the members: P = whirl / ok, p_lo <= P <= p_hi, and the
     // draws respect the declared bounds.

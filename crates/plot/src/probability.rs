@@ -1,7 +1,8 @@
 //! Fig. 4 with probability bands, from an ensemble's `contours.json`: for each friction
 //! coefficient, the speeds where P(whirl) reaches each level (10, 50, 90 % by default) as
-//! lines with their intervals as error bars, the band between the lowest and the highest
-//! level shaded, and every cell's P(whirl) as a dot shaded from white (0) to red (1).
+//! lines with their intervals as error bars (beside the cells, capped where they end in the
+//! range), the band between the lowest and the highest level shaded, and every cell's
+//! P(whirl) as a dot shaded from white (0) to red (1), keyed in the legend.
 //! Groups are placed by their `mu` input; with further (non-speed) axes, all groups are
 //! drawn over each other.
 
@@ -70,7 +71,7 @@ impl Figure for ProbabilityFigure<'_> {
 
         let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (_, bh) = body.dim_in_pixel();
-        let (plot_area, legend_band) = body.split_vertically(bh.saturating_sub(50));
+        let (plot_area, legend_band) = body.split_vertically(bh.saturating_sub(60));
         let mut chart = ChartBuilder::on(&plot_area)
             .margin_top(12)
             .margin_left(14)
@@ -91,16 +92,15 @@ impl Figure for ProbabilityFigure<'_> {
         )?;
 
         // Cells: P(whirl) as a dot from white to red.
+        let cells = chart.plotting_area().strip_coord_spec();
+        let base = chart.plotting_area().get_base_pixel();
         for (mu, g) in &groups {
             for (s, p) in g.speeds_rpm.iter().zip(&g.p_whirl) {
                 let Some(p) = p.filter(|p| p.is_finite() && s.is_finite()) else {
                     continue;
                 };
-                let fill = BAND.mix(0.08 + 0.85 * p.clamp(0.0, 1.0));
-                chart.draw_series([
-                    Circle::new((*mu, *s), 5, fill.filled()),
-                    Circle::new((*mu, *s), 5, RGBColor(150, 150, 150).stroke_width(1)),
-                ])?;
+                let at = chart.backend_coord(&(*mu, *s));
+                cell_dot(&cells, (at.0 - base.0, at.1 - base.1), p)?;
             }
         }
 
@@ -125,6 +125,9 @@ impl Figure for ProbabilityFigure<'_> {
                 chart.draw_series([Polygon::new(poly, BAND.mix(0.12).filled())])?;
             }
         }
+        // Data units per pixel along µ, to set the interval bars beside the cells' dots.
+        let (plot_w, _) = chart.plotting_area().dim_in_pixel();
+        let mu_per_px = (m_hi - m_lo + 2.0 * pad_m) / f64::from(plot_w.max(1));
         // Each level: a line through the crossings and error bars for the intervals.
         for k in 0..n_levels {
             let colour = LEVEL_COLOURS[k % LEVEL_COLOURS.len()];
@@ -140,11 +143,23 @@ impl Figure for ProbabilityFigure<'_> {
                 }
                 let lo = l.speed_lo_rpm.unwrap_or(s_lo - pad_s);
                 let hi = l.speed_hi_rpm.unwrap_or(s_hi + pad_s);
-                let dx = 0.004 * (m_hi - m_lo + 2.0 * pad_m) * (k as f64 - 1.0);
-                chart.draw_series([PathElement::new(
-                    vec![(m + dx, lo), (m + dx, hi)],
-                    colour.mix(0.7).stroke_width(2),
-                )])?;
+                // Side by side to the right of the cells' dots, one level after the other,
+                // with a cap at each end inside the range (none where it runs out of it).
+                let x = m + mu_per_px * (10.0 + 7.0 * k as f64);
+                let cap = 3.0 * mu_per_px;
+                let mut bar = vec![PathElement::new(
+                    vec![(x, lo), (x, hi)],
+                    colour.mix(0.8).stroke_width(2),
+                )];
+                for (end, bounded) in [(lo, l.speed_lo_rpm), (hi, l.speed_hi_rpm)] {
+                    if bounded.is_some() {
+                        bar.push(PathElement::new(
+                            vec![(x - cap, end), (x + cap, end)],
+                            colour.mix(0.8).stroke_width(2),
+                        ));
+                    }
+                }
+                chart.draw_series(bar)?;
             }
             chart.draw_series(
                 pts.iter()
@@ -153,35 +168,52 @@ impl Figure for ProbabilityFigure<'_> {
             )?;
         }
 
-        // Legend: one entry per level.
+        // Legend, two rows: the levels; then the cells' dots with their key and the bars.
         let style = text_style(14.0);
-        let mut x = 60;
-        for (k, l) in self
+        let levels = self
             .contours
             .groups
             .first()
             .map(|g| g.levels.as_slice())
-            .unwrap_or_default()
-            .iter()
-            .enumerate()
-        {
+            .unwrap_or_default();
+        let mut x = 60;
+        for (k, l) in levels.iter().enumerate() {
             let colour = LEVEL_COLOURS[k % LEVEL_COLOURS.len()];
             legend_band.draw(&PathElement::new(
-                vec![(x, 20), (x + 30, 20)],
+                vec![(x, 18), (x + 30, 18)],
                 colour.stroke_width(3),
             ))?;
             let text = format!("P(whirl) = {:.0} %", 100.0 * l.level);
-            legend_band.draw_text(&text, &style, (x + 38, 11))?;
+            legend_band.draw_text(&text, &style, (x + 38, 9))?;
             x += 175;
         }
+        let mut x = 60;
+        let text = format!("cell P(whirl) ({} drops):", self.contours.members);
+        legend_band.draw_text(&text, &style, (x, 35))?;
+        x += legend_band.estimate_text_size(&text, &style)?.0 as i32 + 14;
+        for p in [0.0, 0.5, 1.0] {
+            cell_dot(&legend_band, (x, 43), p)?;
+            legend_band.draw_text(&format!("{p}"), &style, (x + 11, 35))?;
+            x += 44;
+        }
         let text = format!(
-            "bars: {:.0} % intervals; dots: P per cell ({} drops)",
-            100.0 * self.contours.confidence,
-            self.contours.members
+            "bars: {:.0} % intervals, open where they leave the range",
+            100.0 * self.contours.confidence
         );
-        legend_band.draw_text(&text, &style, (x, 11))?;
+        legend_band.draw_text(&text, &style, (x + 20, 35))?;
         Ok(())
     }
+}
+
+/// One cell's P(whirl) as a dot shaded from white (0) to red (1).
+fn cell_dot<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    at: (i32, i32),
+    p: f64,
+) -> DrawResult<DB> {
+    let fill = BAND.mix(0.08 + 0.85 * p.clamp(0.0, 1.0));
+    area.draw(&Circle::new(at, 5, fill.filled()))?;
+    area.draw(&Circle::new(at, 5, RGBColor(150, 150, 150).stroke_width(1)))
 }
 
 /// Draws `charts/fig4_probability.{png,svg}` in `dir` if `dir/contours.json` exists;
