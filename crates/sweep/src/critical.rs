@@ -551,6 +551,29 @@ pub fn search_all<F: Fn(usize, f64) -> Outcome + Sync>(
     n: usize,
     o: &CriticalOptions,
 ) -> Result<Vec<SearchResult>, InvalidParameter> {
+    search_all_expecting(classify_at, n, o, &|_| {})
+}
+
+/// The drops a bisection of `(lo, hi)` down to `tol_rpm` takes when none fails: one per
+/// halving.
+fn bisection_drops(lo: f64, hi: f64, tol_rpm: f64) -> usize {
+    let (mut width, mut n) = (hi - lo, 0);
+    while width > tol_rpm && n < MAX_BISECTIONS {
+        width /= 2.0;
+        n += 1;
+    }
+    n
+}
+
+/// [`search_all`], telling `expect` how many bisection drops each coefficient's scan has
+/// made due, as soon as the scan is done (for a progress bar whose total is known before
+/// the bisections run; a failed probe may add one or two more).
+pub fn search_all_expecting<F: Fn(usize, f64) -> Outcome + Sync>(
+    classify_at: F,
+    n: usize,
+    o: &CriticalOptions,
+    expect: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<SearchResult>, InvalidParameter> {
     o.validate()?;
     let speeds = o.scan_speeds();
     Ok((0..n)
@@ -567,7 +590,14 @@ pub fn search_all<F: Fn(usize, f64) -> Outcome + Sync>(
                 .map(|p| p.speed_rpm)
                 .collect();
             let f = |s: f64| classify_at(j, s);
-            let transitions: Vec<Transition> = transitions_of(&scan)
+            let pairs = transitions_of(&scan);
+            expect(
+                pairs
+                    .iter()
+                    .map(|(lo, hi)| bisection_drops(lo.0, hi.0, o.tol_rpm))
+                    .sum(),
+            );
+            let transitions: Vec<Transition> = pairs
                 .into_par_iter()
                 .map(|(lo, hi)| bisect(&f, lo, hi, o.tol_rpm, &failed))
                 .collect();
@@ -609,8 +639,9 @@ pub fn critical_rows(
 }
 
 /// [`critical_rows`], counting every finished drop on `ticker` (progress for a search that
-/// takes seconds); the ticker expects the scan's drops and learns the bisections' as they
-/// come. The caller finishes the ticker (it may count other drops too).
+/// takes seconds); the ticker expects the scan's drops at once and each coefficient's
+/// bisection drops as soon as its scan is done. The caller finishes the ticker (it may count
+/// other drops too).
 pub fn critical_rows_ticked(
     base: &Scene,
     mus: &[f64],
@@ -674,7 +705,7 @@ fn rows_inner(
         s.validate()?;
     }
     let hashes: Vec<String> = scenes.iter().map(Scene::hash_hex).collect();
-    let results = search_all(
+    let results = search_all_expecting(
         |j, speed| {
             let (mu, hash) = (mus[j], &hashes[j]);
             if cancel.is_some_and(|c| c.requested()) {
@@ -698,6 +729,7 @@ fn rows_inner(
         },
         scenes.len(),
         o,
+        &|n| ticker.expect_more(n),
     )?;
     Ok(results
         .into_iter()
@@ -1085,6 +1117,31 @@ mod tests {
         let json = serde_json::to_string(&one).unwrap();
         let back: Vec<CriticalRow> = serde_json::from_str(&json).unwrap();
         assert_eq!(back, one);
+    }
+
+    #[test]
+    fn the_bisection_drops_are_expected_as_each_scan_ends() {
+        let expected = AtomicUsize::new(0);
+        let calls = AtomicUsize::new(0);
+        let o = opts(2000.0, 9000.0);
+        let step = step_at(5000.0);
+        let r = search_all_expecting(
+            |_, s| {
+                calls.fetch_add(1, Ordering::Relaxed);
+                step(s)
+            },
+            3,
+            &o,
+            &|n| {
+                expected.fetch_add(n, Ordering::Relaxed);
+            },
+        )
+        .unwrap();
+        let scan = 3 * o.scan_speeds().len();
+        // 250 r/min down to 10: five halvings, for one transition per coefficient.
+        assert_eq!(expected.load(Ordering::Relaxed), 3 * 5);
+        assert_eq!(calls.load(Ordering::Relaxed), scan + 3 * 5);
+        assert!(r.iter().all(|r| r.onset_rpm.is_some()));
     }
 
     #[test]
