@@ -24,7 +24,7 @@ use whirlmap_sweep::critical::{
 };
 use whirlmap_sweep::critical_log::DropLog;
 use whirlmap_sweep::progress::Ticker;
-use whirlmap_sweep::recheck::recheck_bracket;
+use whirlmap_sweep::recheck::recheck_rows;
 
 #[derive(clap::Args)]
 pub struct CriticalArgs {
@@ -170,11 +170,7 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
             duration_s: a.duration_s,
             ..Default::default()
         };
-        for row in rows.iter_mut() {
-            let mut s = base.clone();
-            s.mu_dynamic = row.mu;
-            row.recheck = recheck_bracket(&s, row, tighter, &drop_opts);
-        }
+        recheck_rows(&base, &mut rows, tighter, &drop_opts, None);
     }
     let wall_s = start.elapsed().as_secs_f64();
     // The rows are printed first: a CSV that cannot be written (a full disk) loses nothing.

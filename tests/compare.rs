@@ -261,5 +261,30 @@ fn points_in_one_run_only_are_counted_apart_from_those_compared() {
         ),
         "{md}"
     );
+    // A point simulated for another duration is in neither count: it is said apart.
+    let edited = dir.join("edited");
+    std::fs::create_dir_all(&edited).unwrap();
+    let text = std::fs::read_to_string(base.join("points.jsonl")).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    let mut v: serde_json::Value = serde_json::from_str(&lines[0]).unwrap();
+    v["duration_s"] = serde_json::json!(0.1);
+    lines[0] = v.to_string();
+    std::fs::write(edited.join("points.jsonl"), lines.join("\n") + "\n").unwrap();
+    let o = whirlmap(&[
+        "compare",
+        s(&base),
+        s(&edited),
+        "--out",
+        s(&dir.join("d.md")),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", out(&o));
+    assert!(
+        out(&o).contains(
+            "compare: same: 0 of 3 points and 0 of 0 critical speeds changed; \
+             not comparable: 1 point"
+        ),
+        "{}",
+        out(&o)
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

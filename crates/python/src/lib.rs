@@ -26,7 +26,7 @@ use whirlmap_core::{DropOptions, Fidelity, Scene, MODEL_VERSION};
 use whirlmap_sweep::cancel::Cancel;
 use whirlmap_sweep::critical::{check_mus, critical_rows_cancellable, CriticalOptions};
 use whirlmap_sweep::overrides::apply_assignment;
-use whirlmap_sweep::recheck::recheck_bracket;
+use whirlmap_sweep::recheck::recheck_rows;
 use whirlmap_sweep::record::DropRecord;
 use whirlmap_sweep::run::{run_drop, DropFailure};
 use whirlmap_sweep::spec::{self, SweepSpec};
@@ -58,8 +58,10 @@ use whirlmap_sweep::pool::MAX_THREADS;
 /// checks for a signal (Ctrl-C, a notebook's "interrupt kernel") every tenth of a second.
 /// On an interrupt, `cancel` is raised, so the drops not yet started are skipped; the call
 /// waits for the running ones and raises `KeyboardInterrupt` with `interrupted(n)` as its
-/// message, `n` the drops counted on `cancel`. Another exception from a signal handler is
-/// raised as it is.
+/// message, `n` the drops counted on `cancel`. Any other exception from a signal handler (a
+/// subclass of `KeyboardInterrupt` too) stops the work the same way and is raised as it is.
+/// A call from another thread than Python's main one is never interrupted (signals reach
+/// only the main thread).
 fn interruptible<T: Send>(
     py: Python<'_>,
     pool: &rayon::ThreadPool,
@@ -94,7 +96,7 @@ fn interruptible<T: Send>(
             if let Err(e) = py.check_signals() {
                 cancel.request();
                 py.detach(|| join(worker));
-                if !e.is_instance_of::<PyKeyboardInterrupt>(py) {
+                if !e.get_type(py).is(py.get_type::<PyKeyboardInterrupt>()) {
                     return Err(e);
                 }
                 return Err(PyKeyboardInterrupt::new_err(interrupted(
@@ -262,7 +264,8 @@ fn critical(
     let interrupted = |n| {
         format!(
             "critical search interrupted after {n} drops (its scan has {scan}, then \
-             bisections); nothing is returned"
+             bisections and, with a fidelity preset, two re-check drops per onset); nothing \
+             is returned"
         )
     };
     let rows = interruptible(py, &pool, &cancel, interrupted, || {
@@ -274,13 +277,9 @@ fn critical(
                 duration_s,
                 ..Default::default()
             };
-            for row in rows.iter_mut() {
-                if cancel.requested() {
-                    return Ok(None);
-                }
-                let mut s = base.clone();
-                s.mu_dynamic = row.mu;
-                row.recheck = recheck_bracket(&s, row, tighter, &drop_opts);
+            recheck_rows(&base, &mut rows, tighter, &drop_opts, Some(&cancel));
+            if cancel.requested() {
+                return Ok(None);
             }
         }
         Ok::<_, whirlmap_core::InvalidParameter>(Some(rows))

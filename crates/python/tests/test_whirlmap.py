@@ -9,6 +9,7 @@ import os
 import re
 import signal
 import threading
+import traceback
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Iterator
@@ -334,8 +335,31 @@ def test_ctrl_c_stops_a_critical_search_before_its_end() -> None:
         )
     m = re.fullmatch(
         r"critical search interrupted after (\d+) drops \(its scan has (\d+), then "
-        r"bisections\); nothing is returned",
+        r"bisections and, with a fidelity preset, two re-check drops per onset\); "
+        r"nothing is returned",
         str(info.value),
     )
     assert m is not None, str(info.value)
     assert int(m.group(1)) < int(m.group(2)) == 4 * 581
+
+
+def test_another_signal_handlers_exception_stops_a_sweep_too() -> None:
+    class Timeout(Exception):
+        pass
+
+    def on_alarm(signum: int, frame: object) -> None:
+        raise Timeout()
+
+    previous = signal.signal(signal.SIGALRM, on_alarm)
+    try:
+        speeds = list(range(2000, 12000, 5))
+        spec = {"duration_s": 1.0, "axes": {"speed_rpm": speeds, "mu": [0.1]}}
+        with pytest.raises(Timeout) as info:
+            signal.setitimer(signal.ITIMER_REAL, 0.5)
+            whirlmap.sweep(spec, threads=1)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+    # Raised inside the call (its frame is on the traceback), not after it returned.
+    frames = [f.name for f in traceback.extract_tb(info.tb)]
+    assert "sweep" in frames, frames

@@ -117,6 +117,9 @@ pub struct Comparison {
     pub spec_differences: Vec<String>,
     /// Points in both runs that cannot be compared (a different duration), with why.
     pub not_comparable: Vec<String>,
+    /// How many of [`Comparison::not_comparable`] are grid points (the rest are critical
+    /// searches).
+    pub points_not_comparable: usize,
     /// What could not be checked or is partial (a folder without a manifest, a run that did
     /// not finish), to be said loudly.
     pub warnings: Vec<String>,
@@ -131,8 +134,9 @@ impl Comparison {
     }
 
     /// The counts in words: `3 of 64 points and 0 of 5 critical speeds changed`, then, when
-    /// some are in one run only, `; in one run only: 2 points, 1 critical speed`. A point
-    /// or search in one run only counts as a change, but not among those compared.
+    /// some are in one run only, `; in one run only: 2 points, 1 critical speed`, and when
+    /// points in both could not be compared, `; not comparable: 1 point`. A point or search
+    /// in one run only counts as a change, but not among those compared.
     pub fn counts(&self) -> String {
         let one = |n: usize, what: &str| match n {
             1 => format!("1 {what}"),
@@ -152,6 +156,12 @@ impl Comparison {
                 "; in one run only: {}, {}",
                 one(pts_one, "point"),
                 one(crit_one, "critical speed")
+            ));
+        }
+        if self.points_not_comparable > 0 {
+            s.push_str(&format!(
+                "; not comparable: {}",
+                one(self.points_not_comparable, "point")
             ));
         }
         s
@@ -459,6 +469,7 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
         why.extend(not_comparable.iter().take(3).cloned());
         return Err(CompareError::Refused(why));
     }
+    let points_not_comparable = not_comparable.len();
     let (critical_compared, critical) = match (
         read_critical(baseline).map_err(LoadError::from)?,
         read_critical(new).map_err(LoadError::from)?,
@@ -494,6 +505,7 @@ pub fn compare(baseline: &Path, new: &Path, t: Thresholds) -> Result<Comparison,
         runs: [run_info(baseline), run_info(new)],
         spec_differences,
         not_comparable,
+        points_not_comparable,
         warnings,
         new_rows,
     })

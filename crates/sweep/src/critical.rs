@@ -1160,6 +1160,34 @@ mod tests {
         assert_eq!(rows.as_ref(), Some(&plain));
         assert_eq!(cancel.drops_run(), plain[0].drops);
 
+        // Raised while the search runs (after its second drop, on one thread): the drops
+        // not yet started are skipped.
+        let o_long = CriticalOptions {
+            from_rpm: 2000.0,
+            to_rpm: 30000.0,
+            resolution_rpm: 250.0,
+            ..o
+        };
+        let cancel = crate::cancel::Cancel::new();
+        let rows = std::thread::scope(|sc| {
+            sc.spawn(|| {
+                while cancel.drops_run() < 2 {
+                    std::thread::yield_now();
+                }
+                cancel.request();
+            });
+            crate::pool::pool(Some(1)).unwrap().install(|| {
+                critical_rows_cancellable(&scene, &[0.1, 0.4], &o_long, &cancel).unwrap()
+            })
+        });
+        assert_eq!(rows, None);
+        let total = 2 * o_long.scan_speeds().len();
+        assert!(
+            (2..total / 2).contains(&cancel.drops_run()),
+            "{} of {total}",
+            cancel.drops_run()
+        );
+
         let cancel = crate::cancel::Cancel::new();
         cancel.request();
         assert_eq!(

@@ -294,9 +294,10 @@ def critical(
         ValueError: A bad option, friction coefficient or scene parameter (named, with its
             value and allowed range); nothing has run.
         KeyboardInterrupt: Ctrl-C (or a notebook's "interrupt kernel") while the search
-            runs, from the thread that called it: the drops not yet started are skipped, the
-            running ones finish (at most a drop's time), and no row is returned; the message
-            says how many drops had run.
+            runs, when called from Python's main thread: the drops not yet started are
+            skipped, the running ones finish (at most a drop's time: at the tighter preset
+            for a re-check), and no row is returned; the message says how many drops had
+            run. An exception another signal handler raises stops it the same way.
     """
     mus = [float(mu)] if np.isscalar(mu) else [float(m) for m in mu]  # type: ignore[union-attr]
     # The search sets the speed and the friction coefficient of every drop itself.
@@ -376,9 +377,10 @@ def sweep(
         ValueError: The spec is unreadable or invalid (the message names the field, the
             value and the allowed range); nothing has run.
         KeyboardInterrupt: Ctrl-C (or a notebook's "interrupt kernel") while the grid runs,
-            from the thread that called it: the points not yet started are skipped, the
-            running ones finish (at most a drop's time), and no record is returned; the
-            message says how many points had run.
+            when called from Python's main thread: the points not yet started are skipped,
+            the running ones finish (at most a drop's time), and no record is returned; the
+            message says how many points had run. An exception another signal handler
+            raises stops it the same way.
     """
     if isinstance(spec, Mapping):
         spec_dict = dict(spec)
