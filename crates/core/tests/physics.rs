@@ -1230,3 +1230,37 @@ fn orbit_sample_times_strictly_increase() {
         }
     }
 }
+
+// ------------------------------------------------------------------------------------------
+// 12. Continuity at zero gravity
+// ------------------------------------------------------------------------------------------
+
+/// A vertical machine (g = 0): the race starts centred, where its zero-clearance support
+/// carries nothing, and must still be held by its balls once it moves. The drop is the limit
+/// of drops under a vanishing gravity: with g = 1e-6 m/s^2 the race's sag is 1e-14 m and the
+/// fall's timing shifts by far less than the integration error. When the race started off
+/// its support at g = 0 (its guard at zero never crossed), it ran free of its balls and the
+/// same drop whirled at 22 kN instead of 905 N.
+#[test]
+fn a_drop_without_gravity_is_the_limit_of_a_vanishing_gravity() {
+    let run_with = |g: f64| {
+        let mut s = scene(8000.0, 0.3);
+        s.gravity_m_s2 = g;
+        // Something must bring the rotor to the race: a lateral release velocity.
+        s.release_velocity_m_s = [0.005, 0.0];
+        run(&s, 0.1)
+    };
+    let (zero, tiny) = (run_with(0.0), run_with(1e-6));
+    let (f0, f1) = (
+        zero.features.max_contact_force_n,
+        tiny.features.max_contact_force_n,
+    );
+    let race_r = |r: &DropReport| r.final_state[ix::XB].hypot(r.final_state[ix::YB]);
+    // Integration error at rtol 1e-5 (the two drops take different steps): 1e-3.
+    assert!(
+        rel(f0, f1, 0.0) < 1e-3,
+        "max force {f0} N at g = 0, {f1} N at g = 1e-6"
+    );
+    // The race is held within micrometres of its support's centre.
+    assert!(race_r(&zero) < 1e-5, "race {} m off centre", race_r(&zero));
+}

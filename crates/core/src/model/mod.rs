@@ -152,7 +152,11 @@ impl DropSystem {
     /// The release state (docs/model.md#release-state): rotor centre at the housing centre at
     /// rest with spin Omega; race at rest at its static sag on the balls, `(m_b g / k2)^(1/e2)`
     /// below centre.
-    /// Also sets the initial mode (rotor free, race on its support).
+    /// Also sets the initial mode (rotor free, race on its support). Without gravity the race
+    /// starts centred, where its zero-clearance support carries no force yet, and it is on
+    /// its support all the same: the balls push it back as soon as it moves (starting it off
+    /// its support there, the support's guard started at zero and the race ran free of its
+    /// balls for the whole drop).
     pub fn initial_state(&mut self, spin_rad_s: f64) -> [f64; N] {
         let mut y = [0.0; N];
         y[ix::WR] = spin_rad_s;
@@ -161,7 +165,7 @@ impl DropSystem {
         }
         self.mode = Mode {
             contact: false,
-            support: self.g > 0.0,
+            support: true,
             slip: Slip::Slipping(1.0),
         };
         y
