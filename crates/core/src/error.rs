@@ -82,6 +82,20 @@ pub enum SolveError {
         /// Friction heat, damping loss and drag work (J).
         losses_j: f64,
     },
+    /// The drop ended in a state the physics rules out, which an energy audit scaled by a
+    /// large spin energy can miss: friction heat below zero (friction only dissipates, eq.
+    /// 17), or the rotor through the race (the contact stepped over). The results of such a
+    /// drop are not trustworthy.
+    #[error(
+        "unphysical result at t = {t_s:.9} s: {what}; the numerics missed the contact's \
+         dynamics: run the drop at a tighter tolerance (solver.rtol) or fidelity"
+    )]
+    Unphysical {
+        /// Simulated time at the end of the drop (s).
+        t_s: f64,
+        /// What the physics rules out, with its numbers.
+        what: String,
+    },
     /// The scene failed validation.
     #[error(transparent)]
     Invalid(#[from] InvalidParameter),
@@ -96,6 +110,7 @@ impl SolveError {
             SolveError::NonFiniteState { .. } => "non_finite_state",
             SolveError::EventBudget { .. } => "event_budget",
             SolveError::EnergyAudit { .. } => "energy_audit",
+            SolveError::Unphysical { .. } => "unphysical",
             SolveError::Invalid(_) => "invalid_parameter",
         }
     }

@@ -1264,3 +1264,54 @@ fn a_drop_without_gravity_is_the_limit_of_a_vanishing_gravity() {
     // The race is held within micrometres of its support's centre.
     assert!(race_r(&zero) < 1e-5, "race {} m off centre", race_r(&zero));
 }
+
+// ------------------------------------------------------------------------------------------
+// 13. Ends the physics rules out
+// ------------------------------------------------------------------------------------------
+
+/// Two drops at the default numerics whose energy audits close (the audit is scaled by a
+/// spin energy far above the contact's energies) and whose ends the physics rules out:
+/// friction heat below zero (eq. 17's friction power is never negative), and the rotor
+/// through the race. Each fails with the typed `unphysical` error. At a tighter tolerance
+/// they run clean, so the check refuses the numbers, not the scenes: tested on the heavy
+/// rotor; the two stiff contacts at rtol 1e-7 (measured on 2026-11-25: friction heat 12.3 J
+/// and 0 J, audits closed to 5e-10 and 2e-9) take 3 and 6 s each, too long for this file.
+#[test]
+fn ends_the_physics_rules_out_fail_typed_and_a_tighter_tolerance_resolves_them() {
+    let opts = DropOptions {
+        duration_s: 1.0,
+        ..Default::default()
+    };
+    // A contact 5e5 times stiffer than the paper's: the race is driven faster than the rotor
+    // (friction heat -14 J).
+    let mut stiff = Scene::paper();
+    stiff.contact_stiffness_n_per_m_e = 1e15;
+    // A rotor of 400 t, whose spin energy hides the contact's in the audit.
+    let mut heavy = Scene::paper();
+    heavy.rotor_mass_kg = 4e5;
+    heavy.rotor_polar_moi_kg_m2 = 4e3;
+    // A contact 5e6 times stiffer, without friction: the rotor passes through the race.
+    let mut stiffer = Scene::paper();
+    stiffer.contact_stiffness_n_per_m_e = 1e16;
+    stiffer.mu_dynamic = 0.0;
+    for (name, s, words) in [
+        ("stiff", &stiff, "friction heat"),
+        ("heavy", &heavy, "friction heat"),
+        ("stiffer", &stiffer, "through the race"),
+    ] {
+        match simulate(s, &opts) {
+            Err(e @ SolveError::Unphysical { .. }) => {
+                assert_eq!(e.kind(), "unphysical");
+                assert!(e.to_string().contains(words), "{name}: {e}");
+            }
+            other => panic!(
+                "{name}: expected an unphysical end, got {:?}",
+                other.map(|r| r.verdict)
+            ),
+        }
+    }
+    let mut tight = heavy.clone();
+    tight.solver.rtol = 1e-7;
+    let r = simulate(&tight, &opts).unwrap_or_else(|e| panic!("heavy at rtol 1e-7: {e}"));
+    assert!(r.energy.friction_heat_j >= 0.0, "{:?}", r.energy);
+}
