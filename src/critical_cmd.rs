@@ -186,7 +186,16 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
         std::fs::write(p, csv_text(&rows))
             .map_err(|e| Failure::Output(anyhow::anyhow!("cannot write {}: {e}", p.display())))?;
     }
-    Ok(Done::flagged_if(report_undecided(&rows)))
+    let undecided = report_undecided(&rows);
+    let unconfirmed = whirlmap_sweep::critical::unconfirmed_summary(&rows);
+    if let Some(list) = &unconfirmed {
+        errln!(
+            "error: the re-check at the next tighter preset does not confirm the onset at \
+             {list}; the onset at this preset is not to be trusted there: search those \
+             coefficients at the tighter preset"
+        );
+    }
+    Ok(Done::flagged_if(undecided || unconfirmed.is_some()))
 }
 
 /// Says on standard error which rows failed drops left undecided (see

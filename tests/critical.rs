@@ -361,6 +361,48 @@ fn failed_drops_that_leave_the_onset_undecided_exit_1_with_every_row_written() {
     assert!(!err.contains("mu 0.45"), "{err}");
 }
 
+/// A `draft` search whose onset the re-check at `standard` does not confirm (standard whirls
+/// on both sides of the draft bracket, near the paper's onset of about 11 500 r/min at
+/// mu 0.25): every row printed, and exit 1 with the coefficient and what the re-check found.
+/// A confirmed re-check exits 0.
+#[test]
+fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
+    let args = [
+        "critical",
+        "--json",
+        "--mu",
+        "0.25",
+        "--from",
+        "2000",
+        "--to",
+        "16000",
+        "--resolution-rpm",
+        "1000",
+        "--tol-rpm",
+        "100",
+        "--fidelity",
+        "draft",
+        "--no-progress",
+    ];
+    let o = whirlmap(&args);
+    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    let rows: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
+    assert_eq!(rows[0]["recheck"]["confirmed"], false, "{rows}");
+    let err = stderr(&o);
+    assert!(
+        err.contains("does not confirm the onset at mu 0.25 (at standard:")
+            && err.contains("backward_whirl"),
+        "{err}"
+    );
+    // mu 0.35, whose onset near 5 000 r/min both presets find: confirmed, exit 0.
+    let mut ok = args.to_vec();
+    ok[3] = "0.35";
+    let o = whirlmap(&ok);
+    assert_eq!(o.status.code(), Some(0), "{}", out(&o));
+    let rows: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
+    assert_eq!(rows[0]["recheck"]["confirmed"], true, "{rows}");
+}
+
 #[test]
 fn a_sweep_shard_and_merge_exit_1_when_a_critical_speed_is_undecided() {
     let dir = temp_dir("critical-undecided-sweep");

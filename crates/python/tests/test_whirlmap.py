@@ -198,6 +198,16 @@ def test_critical_warns_when_failed_drops_leave_the_onset_undecided() -> None:
     assert rows[0]["failed_drops"] == 4
 
 
+def test_critical_warns_when_the_re_check_does_not_confirm_the_onset() -> None:
+    # At mu 0.25 the draft preset's bracket lies where standard whirls on both sides.
+    with pytest.warns(RuntimeWarning, match="does not confirm the onset at mu 0.25"):
+        rows = whirlmap.critical(
+            0.25, from_rpm=2000, to_rpm=16000, resolution_rpm=1000, tol_rpm=100,
+            fidelity="draft",
+        )  # fmt: skip
+    assert rows[0]["recheck"]["confirmed"] is False
+
+
 def test_critical_checks_before_running() -> None:
     with pytest.raises(ValueError, match="to_rpm"):
         whirlmap.critical(0.4, from_rpm=5000, to_rpm=4000)

@@ -193,6 +193,34 @@ pub fn undecided_summary(rows: &[CriticalRow]) -> Option<String> {
     (!list.is_empty()).then(|| list.join(", "))
 }
 
+/// The rows whose onset bracket the re-check at the tighter preset did not confirm, in
+/// words (`mu 0.25 (at standard: 13312.5 r/min backward_whirl, 13375 r/min
+/// backward_whirl)`); `None` when every re-checked bracket was confirmed or none was
+/// re-checked. The command line then exits 1, as the Python package warns: the onset the
+/// search's own preset found is not the tighter preset's.
+pub fn unconfirmed_summary(rows: &[CriticalRow]) -> Option<String> {
+    let show = |o: &Outcome| match o {
+        Outcome::Class(c) => c.name().to_string(),
+        Outcome::Failed(_) => "failed".to_string(),
+    };
+    let list: Vec<String> = rows
+        .iter()
+        .filter_map(|r| {
+            let rc = r.recheck.as_ref().filter(|rc| !rc.confirmed)?;
+            Some(format!(
+                "mu {} (at {}: {} r/min {}, {} r/min {})",
+                r.mu,
+                rc.fidelity,
+                rc.lo.0,
+                show(&rc.lo.1),
+                rc.hi.0,
+                show(&rc.hi.1)
+            ))
+        })
+        .collect();
+    (!list.is_empty()).then(|| list.join(", "))
+}
+
 /// The bracket cells of a search run again at a tighter fidelity preset.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Recheck {

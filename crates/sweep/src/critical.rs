@@ -54,7 +54,7 @@ const MAX_BISECTIONS: usize = 200;
 const BISECTION_FRACTIONS: [f64; 3] = [0.5, 0.375, 0.625];
 
 pub use whirlmap_results::critical::{
-    csv_text, undecided_summary, CriticalRow, Outcome, Probe, CSV_HEADER,
+    csv_text, unconfirmed_summary, undecided_summary, CriticalRow, Outcome, Probe, CSV_HEADER,
 };
 
 /// Settings of a critical-speed search.

@@ -289,6 +289,8 @@ def critical(
     Warns:
         RuntimeWarning: Some row is undecided (the command line exits 1 then); the message
             names the friction coefficients and their failed drops. Every row is returned.
+            Also when, with a ``fidelity`` preset, the re-check at the next tighter preset
+            does not confirm some row's onset bracket (the command line exits 1 then too).
 
     Raises:
         ValueError: A bad option, friction coefficient or scene parameter (named, with its
@@ -329,6 +331,17 @@ def critical(
             "failed drops leave the critical speed undecided at "
             + ", ".join(undecided)
             + "; every row is returned and its note says why",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    unconfirmed = [
+        f"mu {r['mu']}" for r in rows if r.get("recheck") and not r["recheck"]["confirmed"]
+    ]
+    if unconfirmed:
+        warnings.warn(
+            "the re-check at the next tighter preset does not confirm the onset at "
+            + ", ".join(unconfirmed)
+            + "; the onset at this preset is not to be trusted there (see each row's recheck)",
             RuntimeWarning,
             stacklevel=2,
         )
