@@ -89,7 +89,15 @@ pub fn render_all_keeping(dir: &Path, keep: &[&str]) -> Result<Vec<PathBuf>, Cha
         cause,
     })?;
     let wanted = wanted_charts(dir);
-    let wants = |name: &str| wanted.as_ref().is_none_or(|w| w.iter().any(|c| c == name));
+    // The maps are over release speed and friction: a run without both axes (a sweep over
+    // clearance and friction) has none, rather than one drawn at speed 0.
+    let mapped = rows
+        .iter()
+        .all(|r| r.speed_rpm().is_some() && r.mu().is_some());
+    let wants = |name: &str| {
+        let map = !matches!(name, "critical" | "orbits");
+        (mapped || !map) && wanted.as_ref().is_none_or(|w| w.iter().any(|c| c == name))
+    };
     let mut written = Vec::new();
     if wants("max_force") {
         let fig5 = crate::fig5::figure(&grid);

@@ -366,3 +366,30 @@ fn each_separate_piece_of_a_contour_level_is_labelled() {
     assert!(!svg.contains("drop (uneven grid)"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Records of a sweep over clearance and friction (no speed axis): no map is drawn (one was
+/// drawn at speed 0, on an invented speed range, with clearance as a slice).
+#[test]
+fn no_speed_and_friction_map_without_both_axes() {
+    let dir = temp_dir("no-speed-axis");
+    let mut lines = Vec::new();
+    for (index, (c, mu)) in [(1e-4, 0.1), (2e-4, 0.1), (1e-4, 0.3), (2e-4, 0.3)]
+        .into_iter()
+        .enumerate()
+    {
+        lines.push(
+            json!({"key": format!("p{index}"), "index": index,
+                   "inputs": {"clearance_m": c, "mu": mu},
+                   "scene_hash": "abc", "duration_s": 1.0, "model_version": 1,
+                   "status": "ok",
+                   "record": {"class": "pendulum", "first_contact_force_n": 800.0,
+                              "max_contact_force_n": 900.0, "peak_friction_power_w": 100.0,
+                              "peak_heat_power_w": 110.0, "whirl_frequency_hz": 0.0}})
+            .to_string(),
+        );
+    }
+    std::fs::write(dir.join("points.jsonl"), lines.join("\n") + "\n").unwrap();
+    let written = render_all(&dir).unwrap();
+    assert!(written.is_empty(), "{written:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -5,7 +5,7 @@
 //! data, the worst drops and the assumptions behind every number.
 
 use crate::files::BEARING_REPORT_FILE;
-use crate::point::{load_points, PointRow, PointStatus};
+use crate::point::{load_points, PointRow, PointStatus, MU_KEYS, SPEED_KEYS};
 use std::fmt::Write as _;
 use std::path::Path;
 use whirlmap_core::bearing::{assumptions, BearingPair};
@@ -24,17 +24,33 @@ pub struct ReportSpec {
     pub axes: Vec<String>,
 }
 
-/// Where a drop is, and what a stopped whirl's numbers cover.
+/// Where a drop is (its speed and friction, then its other axes' values; an axis it does
+/// not have is not named), and what a stopped whirl's numbers cover.
 fn at(r: &PointRow) -> String {
-    let mut s = format!(
-        "{} r/min, mu {}",
-        r.speed_rpm().map_or("?".to_string(), |v| format!("{v}")),
-        r.mu().map_or("?".to_string(), |v| format!("{v}"))
-    );
+    let mut s = place(r);
     if let Some(n) = r.whirl_stop_turns {
         s.push_str(&format!(" (a whirl stopped after {n} turns)"));
     }
     s
+}
+
+/// Where a drop is: its speed and friction, then its other axes' values.
+fn place(r: &PointRow) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    if let Some(v) = r.speed_rpm() {
+        parts.push(format!("{v} r/min"));
+    }
+    if let Some(v) = r.mu() {
+        parts.push(format!("mu {v}"));
+    }
+    let axis = |k: &str| SPEED_KEYS.contains(&k) || MU_KEYS.contains(&k);
+    for (k, v) in r.inputs.iter().filter(|(k, _)| !axis(k)) {
+        parts.push(match v.as_f64() {
+            Some(x) => format!("{k} {x}"),
+            None => format!("{k} {v}"),
+        });
+    }
+    parts.join(", ")
 }
 
 /// The report's text.
@@ -252,16 +268,34 @@ pub fn report(spec: &ReportSpec, pair: &BearingPair, rows: &[PointRow]) -> Strin
             .total_cmp(&b.drops_to_failure.unwrap_or(f64::INFINITY))
     });
     let _ = writeln!(w, "## The ten drops with the fewest drops to failure\n");
+    // A speed and a friction column on a speed x friction grid; otherwise one column naming
+    // each drop's axes.
+    let speed_mu = rows.iter().all(|r| {
+        r.speed_rpm().is_some()
+            && r.mu().is_some()
+            && r.inputs
+                .keys()
+                .all(|k| SPEED_KEYS.contains(&k.as_str()) || MU_KEYS.contains(&k.as_str()))
+    });
     let _ = writeln!(
         w,
-        "| speed (r/min) | mu | class | peak contact pressure (GPa) | static safety factor | drops to failure (L10) |\n|---|---|---|---|---|---|"
+        "| {} | class | peak contact pressure (GPa) | static safety factor | drops to failure (L10) |\n|---|---|---|---|---|{}",
+        if speed_mu { "speed (r/min) | mu" } else { "drop" },
+        if speed_mu { "---|" } else { "" }
     );
     for r in by_drops.iter().take(10) {
         let _ = writeln!(
             w,
-            "| {} | {} | {}{} | {:.3} | {:.2} | {:.3e} |",
-            r.speed_rpm().map_or("?".to_string(), |v| format!("{v}")),
-            r.mu().map_or("?".to_string(), |v| format!("{v}")),
+            "| {} | {}{} | {:.3} | {:.2} | {:.3e} |",
+            if speed_mu {
+                format!(
+                    "{} | {}",
+                    r.speed_rpm().map_or(String::new(), |v| format!("{v}")),
+                    r.mu().map_or(String::new(), |v| format!("{v}"))
+                )
+            } else {
+                place(r)
+            },
             r.class.map_or("?", |c| c.name()),
             r.whirl_stop_turns
                 .map_or(String::new(), |n| format!(" (stopped after {n} turns)")),
@@ -381,6 +415,17 @@ mod tests {
             text.contains("The lowest static safety factor is 3.00"),
             "{text}"
         );
+        // A speed axis without a friction axis: the drops are named by the axes they have
+        // (the friction was printed as "?"), in one column.
+        assert!(
+            text.contains("(peak contact pressure 1.40 GPa), at 1000 r/min."),
+            "{text}"
+        );
+        assert!(
+            text.contains("| drop | class |") && text.contains("| 1000 r/min | pendulum |"),
+            "{text}"
+        );
+        assert!(!text.contains('?'), "{text}");
         // The axes: one over the bearing is said.
         let varied = ReportSpec {
             axes: vec!["bearing.balls_per_row".to_string()],

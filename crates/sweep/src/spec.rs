@@ -818,6 +818,35 @@ impl SweepSpec {
                     known: CHART_NAMES.join(", "),
                 });
             }
+            // The grid charts are maps over release speed and friction: without both axes
+            // a missing one would be drawn at 0 and any other axis as a slice of it.
+            let grid_chart = [
+                "max_force",
+                "peak_power",
+                "classes",
+                "peak_temperature",
+                "drops_to_failure",
+                "contact_pressure",
+            ]
+            .contains(&c.as_str());
+            let has_axis =
+                |keys: &[&str]| self.axes.0.iter().any(|a| keys.contains(&a.name.as_str()));
+            if grid_chart
+                && !(has_axis(&whirlmap_results::point::SPEED_KEYS)
+                    && has_axis(&whirlmap_results::point::MU_KEYS))
+            {
+                let names: Vec<&str> = self.axes.0.iter().map(|a| a.name.as_str()).collect();
+                return Err(SpecError::Invalid {
+                    field: "charts".into(),
+                    value: c.clone(),
+                    allowed: format!(
+                        "a map over release speed and friction, which needs the axes \
+                         `speed_rpm` and `mu` (a one-value axis, `\"mu\": [0.4]`, draws one \
+                         row); the axes are {}",
+                        names.join(", ")
+                    ),
+                });
+            }
             // A chart of a model the scene does not run would be silently left out.
             let axis_sets = |section: &str| {
                 self.axes
@@ -1187,6 +1216,8 @@ mod tests {
     fn any_scene_parameter_can_be_an_axis_including_integers() {
         let spec = with(|v| {
             v["axes"] = serde_json::json!({"solver.max_step_attempts": [10, 1000], "unbalance_m": [0, 1e-5]});
+            // Orbit panels only: the maps need speed and friction axes.
+            v["charts"] = serde_json::json!(["orbits"]);
         })
         .unwrap();
         let p = spec.points().unwrap();
@@ -1220,6 +1251,24 @@ mod tests {
         assert!(e.contains("axes.speed_rpm") && e.contains("5000"), "{e}");
         let e = err(|v| v["charts"] = serde_json::json!(["orbits", "pie"]));
         assert!(e.contains("charts") && e.contains("pie"), "{e}");
+        // A map over speed and friction without a speed axis (it was drawn at speed 0).
+        let e = err(|v| {
+            v["axes"] = serde_json::json!({"clearance_m": [1e-4, 2e-4], "mu": [0.1, 0.3]});
+            v["charts"] = serde_json::json!(["critical", "classes"]);
+        });
+        assert!(
+            e.contains("charts = classes")
+                && e.contains("`speed_rpm` and `mu`")
+                && e.contains("the axes are clearance_m, mu"),
+            "{e}"
+        );
+        // The same with a one-value speed axis: one column, accepted.
+        with(|v| {
+            v["axes"] = serde_json::json!({"speed_rpm": [8000], "clearance_m": [1e-4, 2e-4],
+                                           "mu": [0.1, 0.3]});
+            v["charts"] = serde_json::json!(["classes"]);
+        })
+        .unwrap();
         let e = err(|v| v["axes"]["clearence_m"] = serde_json::json!([1e-4]));
         assert!(
             e.contains("axes.clearence_m") && e.contains("clearance_m"),
