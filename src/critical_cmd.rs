@@ -206,7 +206,7 @@ pub(crate) fn report_undecided(rows: &[CriticalRow]) -> bool {
         return false;
     };
     errln!(
-        "error: failed drops leave the critical speed undecided at {list}; every row is \
+        "error: failed or unsettled drops leave the critical speed undecided at {list}; every row is \
          written and its note says why"
     );
     true

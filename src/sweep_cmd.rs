@@ -86,7 +86,7 @@ pub(crate) fn critical_line(dir: &Path, path: &Path) -> bool {
         return false;
     }
     outln!(
-        "  critical speeds  {} ({} of {} undecided by failed drops: {})",
+        "  critical speeds  {} ({} of {} undecided by failed or unsettled drops: {})",
         path.display(),
         undecided.len(),
         rows.len(),

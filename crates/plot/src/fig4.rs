@@ -6,7 +6,7 @@
 //! - the **onset** of sustained whirl per friction coefficient as one curve (dots joined
 //!   between neighbouring coefficients that both whirl in the range); an onset found already
 //!   at the lowest scanned speed carries a downward arrow (at or below it); an onset that
-//!   failed drops leave undecided (`undecided` in `critical.json`) is an open circle, joined
+//!   failed or unsettled drops leave undecided (`undecided` in `critical.json`) is an open circle, joined
 //!   to no neighbour;
 //! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
 //!   to the top of the searched range;
@@ -285,7 +285,7 @@ impl Figure for Fig4<'_> {
         if any_undecided {
             entries.push((
                 Mark::OpenDot(BAND),
-                "onset undecided: failed drops could move it".to_string(),
+                "onset undecided: failed or unsettled drops could move it".to_string(),
             ));
         }
         if any_none {

@@ -198,6 +198,18 @@ def test_critical_warns_when_failed_drops_leave_the_onset_undecided() -> None:
     assert rows[0]["failed_drops"] == 4
 
 
+def test_critical_warns_when_unsettled_drops_leave_the_onset_undecided() -> None:
+    # A backward whirl with intermittent contact at 12000 r/min, below the first continuous
+    # whirl at 13000: the classifier calls it unresolved, and the onset above it is undecided.
+    with pytest.warns(RuntimeWarning, match=r"mu 0.3 \(0 of \d+ drops failed, \d+ did not settle\)"):
+        rows = whirlmap.critical(
+            0.3, from_rpm=8000, to_rpm=28000, resolution_rpm=2000, tol_rpm=500,
+            unbalance_m=5e-6, clearance_m=2.5e-4,
+        )  # fmt: skip
+    assert rows[0]["undecided"] is True
+    assert rows[0]["note"].startswith("UNDECIDED: 1 drop(s) below the onset")
+
+
 def test_critical_warns_when_the_re_check_does_not_confirm_the_onset() -> None:
     # At mu 0.25 the draft preset's bracket lies where standard whirls on both sides.
     with pytest.warns(RuntimeWarning, match="does not confirm the onset at mu 0.25"):

@@ -184,10 +184,20 @@ pub fn undecided_summary(rows: &[CriticalRow]) -> Option<String> {
         .iter()
         .filter(|r| r.undecided)
         .map(|r| {
-            format!(
-                "mu {} ({} of {} drops failed)",
-                r.mu, r.failed_drops, r.drops
-            )
+            let unsettled = r
+                .scan
+                .iter()
+                .chain(&r.bisections)
+                .filter(|p| p.class == Some(OrbitClass::Unresolved))
+                .count();
+            match (r.failed_drops, unsettled) {
+                (f, 0) => format!("mu {} ({f} of {} drops failed)", r.mu, r.drops),
+                (0, u) => format!("mu {} ({u} of {} drops did not settle)", r.mu, r.drops),
+                (f, u) => format!(
+                    "mu {} ({f} of {} drops failed, {u} did not settle)",
+                    r.mu, r.drops
+                ),
+            }
         })
         .collect();
     (!list.is_empty()).then(|| list.join(", "))

@@ -475,7 +475,7 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
         .count();
     if unresolved > 0 {
         notes.push(format!(
-            "{unresolved} unresolved drop(s) counted as no whirl"
+            "{unresolved} unresolved drop(s) counted as no whirl in the intervals"
         ));
     }
     let bisection_failures = transitions
@@ -504,6 +504,36 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
         .collect();
     // Failed drops that could change the onset: see `hiding_failures`.
     let hiding = hiding_failures(onset, &failed_speeds);
+    // So could drops below it that did not settle: an unresolved motion may be a whirl the
+    // classifier could not name (a backward whirl with intermittent contact).
+    let unsettled_speeds: Vec<f64> = scan
+        .iter()
+        .chain(transitions.iter().flat_map(|t| &t.probes))
+        .filter(|p| p.class == Some(OrbitClass::Unresolved))
+        .map(|p| p.speed_rpm)
+        .collect();
+    let unsettled = hiding_failures(onset, &unsettled_speeds);
+    if !ok.is_empty() && !unsettled.is_empty() {
+        notes.insert(
+            0,
+            match onset {
+                Some(x) => format!(
+                    "UNDECIDED: {} drop(s) below the onset {} r/min did not settle (unresolved, \
+                     at {} r/min), where a whirl the classifier could not name would give a \
+                     lower onset",
+                    unsettled.len(),
+                    fmt_rpm(x),
+                    rpm_list(&unsettled)
+                ),
+                None => format!(
+                    "UNDECIDED: {} drop(s) did not settle (unresolved, at {} r/min), where a \
+                     whirl the classifier could not name may hide",
+                    unsettled.len(),
+                    rpm_list(&unsettled)
+                ),
+            },
+        );
+    }
     if !ok.is_empty() && !hiding.is_empty() {
         notes.insert(
             0,
@@ -523,7 +553,7 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
             },
         );
     }
-    let undecided = ok.is_empty() || !hiding.is_empty();
+    let undecided = ok.is_empty() || !hiding.is_empty() || !unsettled.is_empty();
     SearchResult {
         onset_rpm: onset,
         bracket_rpm: bracket,
@@ -983,6 +1013,53 @@ mod tests {
         assert_eq!(r.failed_drops(), 2);
         assert!(r.note.contains("2 drop(s) failed"), "{}", r.note);
         assert!(!r.note.contains("UNDECIDED"), "{}", r.note);
+    }
+
+    /// Unresolved drops (the motion did not settle into a class; a backward whirl with
+    /// intermittent contact is one) below the onset leave it undecided, as failed drops do:
+    /// they were counted as no whirl, so the onset above them was reported as decided.
+    #[test]
+    fn unresolved_drops_below_the_onset_or_without_whirl_leave_it_undecided() {
+        let with_unresolved = |threshold: f64, at: &'static [f64]| {
+            move |s: f64| {
+                Outcome::Class(if at.contains(&s) {
+                    Unresolved
+                } else if s >= threshold {
+                    BackwardWhirl
+                } else {
+                    Pendulum
+                })
+            }
+        };
+        let o = opts(2000.0, 9000.0);
+        let r = search(with_unresolved(4400.0, &[3000.0]), &o).unwrap();
+        assert!(r.undecided && !r.converged, "{}", r.note);
+        assert!(
+            r.note
+                .starts_with("UNDECIDED: 1 drop(s) below the onset 4406.2 r/min")
+                && r.note
+                    .contains("did not settle (unresolved, at 3000 r/min)"),
+            "{}",
+            r.note
+        );
+        let row = r.into_row(0.3, &o, "x".into());
+        assert_eq!(
+            undecided_summary(std::slice::from_ref(&row)).as_deref(),
+            Some(format!("mu 0.3 (1 of {} drops did not settle)", row.drops).as_str())
+        );
+        // Above the onset they cannot lower it: decided.
+        let r = search(with_unresolved(4400.0, &[6000.0]), &o).unwrap();
+        assert!(!r.undecided && r.converged, "{}", r.note);
+        // No whirl found: any of them may hide a whirl.
+        let r = search(with_unresolved(1e9, &[5000.0]), &o).unwrap();
+        assert_eq!(r.onset_rpm, None);
+        assert!(r.undecided, "{}", r.note);
+        assert!(
+            r.note
+                .contains("UNDECIDED: 1 drop(s) did not settle (unresolved, at 5000 r/min)"),
+            "{}",
+            r.note
+        );
     }
 
     #[test]

@@ -283,12 +283,14 @@ def critical(
         ``drops``, ``note``, ``scan``, ``bisections``, ...). ``pandas.DataFrame(rows)``
         reads them. A failed drop is recorded in its row; when failed drops leave a row's
         onset undecided (every scan drop failed, or one failed below the onset, or any
-        when no whirl was found), the row has ``undecided`` true (the key is there only
-        then) and ``converged`` false.
+        when no whirl was found), or drops that did not settle (class ``unresolved``) do
+        (below the onset, or any when no whirl was found), the row has ``undecided`` true
+        (the key is there only then) and ``converged`` false.
 
     Warns:
         RuntimeWarning: Some row is undecided (the command line exits 1 then); the message
-            names the friction coefficients and their failed drops. Every row is returned.
+            names the friction coefficients and their failed or unsettled drops. Every row
+            is returned.
             Also when, with a ``fidelity`` preset, the re-check at the next tighter preset
             does not confirm some row's onset bracket (the command line exits 1 then too).
 
@@ -321,14 +323,19 @@ def critical(
         _threads(threads),
     )
     rows: List[Dict[str, Any]] = json.loads(text)
+    def unsettled(r: Dict[str, Any]) -> int:
+        probes = list(r.get("scan", [])) + list(r.get("bisections", []))
+        return sum(1 for p in probes if p.get("class") == "unresolved")
+
     undecided = [
-        f"mu {r['mu']} ({r['failed_drops']} of {r['drops']} drops failed)"
+        f"mu {r['mu']} ({r['failed_drops']} of {r['drops']} drops failed"
+        + (f", {unsettled(r)} did not settle)" if unsettled(r) else ")")
         for r in rows
         if r.get("undecided")
     ]
     if undecided:
         warnings.warn(
-            "failed drops leave the critical speed undecided at "
+            "failed or unsettled drops leave the critical speed undecided at "
             + ", ".join(undecided)
             + "; every row is returned and its note says why",
             RuntimeWarning,
