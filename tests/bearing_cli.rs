@@ -252,8 +252,23 @@ fn bad_bearing_fields_are_named_by_their_dotted_key_with_value_and_range() {
 
 #[test]
 fn the_bearing_flag_is_applied_before_set() {
-    let three = record(&["--bearing", "--set", "bearing.rows=3"]);
+    // Three rows, with their own ratings (the default pair's are refused for them).
+    let three = record(&[
+        "--bearing",
+        "--set",
+        "bearing.rows=3",
+        "--set",
+        "bearing.dynamic_rating_n=25854",
+        "--set",
+        "bearing.static_rating_n=31116",
+    ]);
     let two = record(&["--bearing"]);
+    // The default pair's ratings with three rows: refused, naming the rating.
+    let e = refused(&["--bearing", "--set", "bearing.rows=3"]);
+    assert!(
+        e.contains("bearing.dynamic_rating_n = 19470") && e.contains("ISO 281 gives 25854 N"),
+        "{e}"
+    );
     assert!(
         three["peak_ball_load_n"].as_f64().unwrap() < two["peak_ball_load_n"].as_f64().unwrap(),
         "three rows share the load: {} vs {}",

@@ -213,6 +213,53 @@ impl BearingPair {
                 ),
             ));
         }
+        // The ratings are numbers of the default pair: with another geometry they would be
+        // left at its values without a word, and the damage and safety factors with them.
+        let d = BearingPair::paper_71908_cd();
+        let geometry_changed = self.ball_diameter_m != d.ball_diameter_m
+            || self.pitch_diameter_m != d.pitch_diameter_m
+            || self.balls_per_row != d.balls_per_row
+            || self.rows != d.rows
+            || self.contact_angle_rad != d.contact_angle_rad
+            || self.inner_conformity != d.inner_conformity
+            || self.outer_conformity != d.outer_conformity;
+        if geometry_changed {
+            let iso281 = self
+                .iso281_dynamic_rating_n()
+                .map_or("no ISO 281 value: balls above 25.4 mm".to_string(), |c| {
+                    format!("ISO 281 gives {} N for it", approx(c))
+                });
+            let unchanged = [
+                (
+                    "bearing.dynamic_rating_n",
+                    self.dynamic_rating_n,
+                    d.dynamic_rating_n,
+                    iso281,
+                ),
+                (
+                    "bearing.static_rating_n",
+                    self.static_rating_n,
+                    d.static_rating_n,
+                    format!(
+                        "ISO 76 gives {} N for it",
+                        approx(self.iso76_static_rating_n())
+                    ),
+                ),
+            ];
+            for (field, value, default, formula) in unchanged {
+                if value == default {
+                    return Err(InvalidParameter::new(
+                        field,
+                        num(value),
+                        &format!(
+                            "the rating of this pair's geometry: {value} N is the default \
+                             pair's, and the geometry is not the default's ({formula}); set \
+                             {field} to the catalogue rating or to that value"
+                        ),
+                    ));
+                }
+            }
+        }
         Ok(())
     }
 
@@ -543,18 +590,66 @@ mod tests {
         };
         let e = many.validate().unwrap_err().to_string();
         assert!(e.contains("pi * 0.051 / 200"), "{e}");
-        // Just fitting is allowed: 29 balls of 5.5 mm take 159.5 mm of 160.2 mm.
-        BearingPair {
+        // Just fitting is allowed: 29 balls of 5.5 mm take 159.5 mm of 160.2 mm (with the
+        // pair's own ratings).
+        let fitting = BearingPair {
             balls_per_row: 29,
             ..d.clone()
+        };
+        BearingPair {
+            dynamic_rating_n: fitting.iso281_dynamic_rating_n().unwrap(),
+            static_rating_n: fitting.iso76_static_rating_n(),
+            ..fitting
         }
         .validate()
         .unwrap();
-        BearingPair {
+        let e = BearingPair {
             balls_per_row: 30,
             ..d
         }
         .validate()
         .unwrap_err();
+        assert_eq!(e.field, "bearing.ball_diameter_m");
+    }
+
+    /// Another geometry with the default pair's ratings is refused, naming the rating and the
+    /// value its formula gives (the damage and safety factors stayed at the default pair's
+    /// ratings whatever the geometry); with ratings of its own it is accepted.
+    #[test]
+    fn another_geometry_needs_its_own_ratings() {
+        let three_rows = BearingPair {
+            rows: 3,
+            ..BearingPair::default()
+        };
+        let e = three_rows.validate().unwrap_err();
+        let c = three_rows.iso281_dynamic_rating_n().unwrap();
+        assert_eq!(e.field, "bearing.dynamic_rating_n");
+        assert!(
+            e.to_string()
+                .contains(&format!("ISO 281 gives {} N for it", approx(c))),
+            "{e}"
+        );
+        let e = BearingPair {
+            dynamic_rating_n: c,
+            ..three_rows.clone()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(e.field, "bearing.static_rating_n");
+        BearingPair {
+            dynamic_rating_n: 25_000.0,
+            static_rating_n: 30_000.0,
+            ..three_rows
+        }
+        .validate()
+        .unwrap();
+        // The default pair, and a default geometry with a catalogue rating, pass.
+        BearingPair::default().validate().unwrap();
+        BearingPair {
+            dynamic_rating_n: 17_800.0,
+            ..BearingPair::default()
+        }
+        .validate()
+        .unwrap();
     }
 }
