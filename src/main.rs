@@ -93,8 +93,9 @@ struct SchemaArgs {
 /// `whirlmap scene`'s options.
 #[derive(clap::Args)]
 struct SceneArgs {
-    /// Also give the thermal model's parameters their defaults (`thermal` is `null`, the
-    /// model off, without it; a scene file with them switches the thermal model on).
+    /// Also give the thermal model's and the bearing analysis's parameters their defaults
+    /// (`thermal` and `bearing` are `null`, both off, without it; a scene file with them
+    /// switches them on).
     #[arg(long)]
     all: bool,
     /// Print the scene's JSON Schema instead: type, default, unit (`x-unit`), allowed range

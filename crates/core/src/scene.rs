@@ -773,8 +773,11 @@ impl Scene {
                 "pitch_diameter_m",
                 num(self.pitch_diameter_m),
                 &format!(
-                    "> the race bore diameter rotor_diameter_m + 2 clearance_m = {} m (the \
-                     bearing's balls run outside its bore)",
+                    "> the race bore diameter rotor_diameter_m + 2 clearance_m = {} + 2 * {} = \
+                     {} m (the bearing's balls run outside its bore: a smaller clearance_m or \
+                     rotor_diameter_m, or a larger pitch_diameter_m)",
+                    num(self.rotor_diameter_m),
+                    num(self.clearance_m),
                     approx(bore_d)
                 ),
             ));

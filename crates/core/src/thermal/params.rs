@@ -340,14 +340,26 @@ impl ThermalParams {
             return Err(InvalidParameter::new(
                 "thermal.ball_diameter_m",
                 self.ball_diameter_m,
-                "< pitch_diameter_m - 2 * race bore radius (the inner raceway must lie outside the bore)",
+                &format!(
+                    "< pitch_diameter_m - 2 * race bore radius = {} - 2 * {} = {} m (the inner \
+                     raceway must lie outside the bore)",
+                    crate::scene::num(pitch_diameter_m),
+                    crate::scene::num(race_bore_radius_m),
+                    crate::scene::approx(pitch_diameter_m - 2.0 * race_bore_radius_m)
+                ),
             ));
         }
         if !(r_e < 0.5 * self.outer_diameter_m) {
             return Err(InvalidParameter::new(
                 "thermal.outer_diameter_m",
                 self.outer_diameter_m,
-                "> pitch_diameter_m + ball_diameter_m (outside the outer raceway)",
+                &format!(
+                    "> pitch_diameter_m + thermal.ball_diameter_m = {} + {} = {} m (outside the \
+                     outer raceway; set thermal.outer_diameter_m with a new pitch_diameter_m)",
+                    crate::scene::num(pitch_diameter_m),
+                    crate::scene::num(self.ball_diameter_m),
+                    crate::scene::approx(2.0 * r_e)
+                ),
             ));
         }
         let z = self.ball_count as f64;
