@@ -18,9 +18,10 @@ const TINY: &str = r#"{"name": "tiny", "scene": {"classification": {"max_extensi
 const SLOW: &str = r#"{"name": "slow", "scene": {"solver": {"rtol": 1e-9}},
   "duration_s": 1.0, "axes": {"speed_rpm": [2000, 4000, 6000, 8000], "mu": [0.1, 0.2, 0.3, 0.4]}}"#;
 
-/// A sweep with a small critical search and its Fig. 4.
+/// A sweep with a small critical search and its Fig. 4, whose drops are extended until they
+/// settle (an unresolved drop below an onset, or without one, would leave it undecided:
+/// exit 1).
 const WITH_CRITICAL: &str = r#"{"name": "withcrit",
-  "scene": {"classification": {"max_extension_s": 0}},
   "duration_s": 0.05, "axes": {"speed_rpm": [4000, 8000], "mu": [0.1, 0.3]},
   "critical": {"mu": [0.4], "speed_rpm": {"from": 2000, "to": 4000},
                "resolution_rpm": 1000, "tol_rpm": 500},
