@@ -45,6 +45,10 @@ pub const CHART_NAMES: &[&str] = &[
     "contact_pressure",
 ];
 
+/// The charts of [`CHART_NAMES`] that are maps over release speed and friction, every one
+/// after the orbit panels and Fig. 4: a spec listing one needs a `speed_rpm` and a `mu` axis.
+pub const MAP_CHARTS: &[&str] = CHART_NAMES.split_at(2).1;
+
 /// Largest grid a spec may describe (points). The count is checked, with checked arithmetic,
 /// before any axis is built; larger grids are refused (exit 2).
 pub const MAX_POINTS: usize = 10_000_000;
@@ -820,15 +824,7 @@ impl SweepSpec {
             }
             // The grid charts are maps over release speed and friction: without both axes
             // a missing one would be drawn at 0 and any other axis as a slice of it.
-            let grid_chart = [
-                "max_force",
-                "peak_power",
-                "classes",
-                "peak_temperature",
-                "drops_to_failure",
-                "contact_pressure",
-            ]
-            .contains(&c.as_str());
+            let grid_chart = MAP_CHARTS.contains(&c.as_str());
             let has_axis =
                 |keys: &[&str]| self.axes.0.iter().any(|a| keys.contains(&a.name.as_str()));
             if grid_chart
@@ -1237,6 +1233,13 @@ mod tests {
         assert!(e.contains("step") && e.contains("line"), "{e}");
         let e = err(|v| v["critical"]["tolerance"] = Value::from(1));
         assert!(e.contains("tolerance"), "{e}");
+    }
+
+    #[test]
+    fn the_maps_are_the_charts_after_the_orbit_panels_and_fig_4() {
+        assert_eq!(&CHART_NAMES[..2], &["orbits", "critical"]);
+        assert!(MAP_CHARTS.contains(&"max_force") && MAP_CHARTS.contains(&"contact_pressure"));
+        assert_eq!(MAP_CHARTS.len() + 2, CHART_NAMES.len());
     }
 
     #[test]
