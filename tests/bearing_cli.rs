@@ -263,6 +263,20 @@ fn the_bearing_flag_is_applied_before_set() {
         "bearing.static_rating_n=31116",
     ]);
     let two = record(&["--bearing"]);
+    // A scene bearing (the drag's pitch circle) other than the one analysed: refused.
+    let e = refused(&[
+        "--bearing",
+        "--set",
+        "rotor_diameter_m=0.08",
+        "--set",
+        "pitch_diameter_m=0.1",
+        "--set",
+        "rotor_polar_moi_kg_m2=0.02",
+    ]);
+    assert!(
+        e.contains("bearing.pitch_diameter_m = 0.051") && e.contains("pitch_diameter_m = 0.1 m"),
+        "{e}"
+    );
     // The default pair's ratings with three rows: refused, naming the rating.
     let e = refused(&["--bearing", "--set", "bearing.rows=3"]);
     assert!(

@@ -495,6 +495,19 @@ impl Scene {
         }
         if let Some(b) = &self.bearing {
             b.validate()?;
+            // One bearing: the one analysed is the one whose drag the dynamics use (eqs.
+            // 11-13 take d_m); a journal larger than the analysed pitch circle went unseen.
+            if b.pitch_diameter_m != self.pitch_diameter_m {
+                return Err(InvalidParameter::new(
+                    "bearing.pitch_diameter_m",
+                    num(b.pitch_diameter_m),
+                    &format!(
+                        "= pitch_diameter_m = {} m, the drag model's pitch diameter of the same \
+                         bearing: set both",
+                        num(self.pitch_diameter_m)
+                    ),
+                ));
+            }
         }
         Ok(())
     }
