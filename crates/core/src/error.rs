@@ -83,9 +83,8 @@ pub enum SolveError {
         losses_j: f64,
     },
     /// The drop ended in a state the physics rules out, which an energy audit scaled by a
-    /// large spin energy can miss: friction heat below zero (friction only dissipates, eq.
-    /// 17), or the rotor through the race (the contact stepped over). The results of such a
-    /// drop are not trustworthy.
+    /// large spin energy can miss: the rotor through the race with the contact not acting
+    /// (a contact stepped over). The results of such a drop are not trustworthy.
     #[error(
         "unphysical result at t = {t_s:.9} s: {what}; the numerics missed the contact's \
          dynamics: run the drop at a tighter tolerance (solver.rtol) or fidelity"

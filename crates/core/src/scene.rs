@@ -401,9 +401,10 @@ impl Scene {
     /// The bearing pair the analysis runs with, if the scene turns it on: the scene's
     /// `bearing`, with its lumped stiffness taken from the support law (k2, eq. 7) when the
     /// support exponent is Hertz's 1.5, so that the ball loads resolve to the force the
-    /// dynamics apply.
+    /// dynamics apply, and with ratings left at the default pair's values following its
+    /// geometry ([`crate::bearing::BearingPair::with_ratings_of_its_geometry`]).
     pub fn bearing_as_run(&self) -> Option<crate::bearing::BearingPair> {
-        let mut pair = self.bearing.clone()?;
+        let mut pair = self.bearing.clone()?.with_ratings_of_its_geometry();
         if self.support_exponent == 1.5 {
             pair.lumped_stiffness_n_per_m1_5 = self.support_stiffness_n_per_m_e;
         }

@@ -254,8 +254,18 @@ pub fn report(spec: &ReportSpec, pair: &BearingPair, rows: &[PointRow]) -> Strin
         pair.static_limit_pressure_pa != paper.static_limit_pressure_pa,
         pair.lumped_stiffness_n_per_m1_5 != paper.lumped_stiffness_n_per_m1_5,
     ];
-    for ((q, v, src), changed) in rows_table.into_iter().zip(changed) {
-        let src = if changed { "the scene" } else { src };
+    // A rating that followed the geometry is its formula's, not a value the scene gave.
+    let from_formula = [
+        pair.iso281_dynamic_rating_n() == Some(pair.dynamic_rating_n),
+        pair.iso76_static_rating_n() == pair.static_rating_n,
+    ];
+    for (k, ((q, v, src), changed)) in rows_table.into_iter().zip(changed).enumerate() {
+        let src = match k {
+            7 if changed && from_formula[0] => "ISO 281's formula for this geometry",
+            8 if changed && from_formula[1] => "ISO 76 for this geometry",
+            _ if changed => "the scene",
+            _ => src,
+        };
         let _ = writeln!(w, "| {q} | {v} | {src} |");
     }
     let _ = writeln!(w);

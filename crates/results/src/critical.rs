@@ -176,19 +176,22 @@ pub fn csv_text(rows: &[CriticalRow]) -> String {
     s
 }
 
-/// The rows whose onset failed drops left undecided, as `mu 0.4 (4 of 4 drops failed),
-/// mu 0.5 (1 of 9 drops failed)`; `None` when there is none. The command line's message and
+/// The rows whose onset failed drops, or drops that did not settle, left undecided, as
+/// `mu 0.4 (4 of 4 drops failed), mu 0.3 (1 of 17 drops did not settle)` (the unsettled
+/// ones counted below the onset); `None` when there is none. The command line's message and
 /// exit code, and the Python package's warning, are built on it.
 pub fn undecided_summary(rows: &[CriticalRow]) -> Option<String> {
     let list: Vec<String> = rows
         .iter()
         .filter(|r| r.undecided)
         .map(|r| {
+            // The unsettled drops that could hide the onset: below it, or any without one.
             let unsettled = r
                 .scan
                 .iter()
                 .chain(&r.bisections)
                 .filter(|p| p.class == Some(OrbitClass::Unresolved))
+                .filter(|p| r.onset_rpm.is_none_or(|x| p.speed_rpm < x))
                 .count();
             match (r.failed_drops, unsettled) {
                 (f, 0) => format!("mu {} ({f} of {} drops failed)", r.mu, r.drops),

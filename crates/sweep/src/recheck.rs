@@ -61,7 +61,10 @@ fn recheck_with(
     let [lo, hi] = row.bracket_rpm?;
     let s = tighter.applied(scene);
     let (out_lo, out_hi) = rayon::join(|| run(&s, lo), || run(&s, hi));
-    let confirmed = out_lo.whirl() == Some(false) && out_hi.whirl() == Some(true);
+    // A settled class below: an unresolved drop is no confirmation (below an onset it
+    // leaves a search undecided).
+    let settled_below = matches!(&out_lo, Outcome::Class(c) if !c.is_whirl() && *c != whirlmap_core::classify::OrbitClass::Unresolved);
+    let confirmed = settled_below && out_hi.whirl() == Some(true);
     Some(Recheck {
         fidelity: tighter,
         lo: (lo, out_lo),

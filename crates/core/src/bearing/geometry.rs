@@ -213,52 +213,17 @@ impl BearingPair {
                 ),
             ));
         }
-        // The ratings are numbers of the default pair: with another geometry they would be
-        // left at its values without a word, and the damage and safety factors with them.
+        // A rating left at the default pair's value on a geometry its formula does not
+        // cover cannot follow the geometry ([`BearingPair::with_ratings_of_its_geometry`]).
         let d = BearingPair::paper_71908_cd();
-        let geometry_changed = self.ball_diameter_m != d.ball_diameter_m
-            || self.pitch_diameter_m != d.pitch_diameter_m
-            || self.balls_per_row != d.balls_per_row
-            || self.rows != d.rows
-            || self.contact_angle_rad != d.contact_angle_rad
-            || self.inner_conformity != d.inner_conformity
-            || self.outer_conformity != d.outer_conformity;
-        if geometry_changed {
-            let iso281 = self
-                .iso281_dynamic_rating_n()
-                .map_or("no ISO 281 value: balls above 25.4 mm".to_string(), |c| {
-                    format!("ISO 281 gives {} N for it", approx(c))
-                });
-            let unchanged = [
-                (
-                    "bearing.dynamic_rating_n",
-                    self.dynamic_rating_n,
-                    d.dynamic_rating_n,
-                    iso281,
-                ),
-                (
-                    "bearing.static_rating_n",
-                    self.static_rating_n,
-                    d.static_rating_n,
-                    format!(
-                        "ISO 76 gives {} N for it",
-                        approx(self.iso76_static_rating_n())
-                    ),
-                ),
-            ];
-            for (field, value, default, formula) in unchanged {
-                if value == default {
-                    return Err(InvalidParameter::new(
-                        field,
-                        num(value),
-                        &format!(
-                            "the rating of this pair's geometry: {value} N is the default \
-                             pair's, and the geometry is not the default's ({formula}); set \
-                             {field} to the catalogue rating or to that value"
-                        ),
-                    ));
-                }
-            }
+        if self.dynamic_rating_n == d.dynamic_rating_n && self.iso281_dynamic_rating_n().is_none() {
+            return Err(InvalidParameter::new(
+                "bearing.dynamic_rating_n",
+                num(self.dynamic_rating_n),
+                "the pair's own rating: 19470 N is the default pair's, and ISO 281's formula, \
+                 from which it would follow this geometry, does not cover it (balls above \
+                 25.4 mm, or D cos(alpha) / d_m outside [0.05, 0.2]); set the catalogue rating",
+            ));
         }
         Ok(())
     }
@@ -432,6 +397,33 @@ impl BearingPair {
         self.rows as f64 * self.balls_per_row as f64 * self.contact_angle_rad.cos() * q / 5.0
     }
 
+    /// This pair with each rating left at the default pair's value replaced by its formula's
+    /// value for this geometry and material (ISO 281 for `C`, ISO 76 for `C_0`), when that
+    /// differs from the formula's value for the default pair: the defaults are those formulas'
+    /// values for the default pair, and a geometry change left them behind (the damage stayed
+    /// at the default pair's rating whatever the rows, balls or contact angle). A rating set
+    /// to anything else is the user's, a catalogue's, and is kept.
+    pub fn with_ratings_of_its_geometry(mut self) -> Self {
+        let d = BearingPair::paper_71908_cd();
+        let moved = |own: f64, default: f64| (own - default).abs() > 1e-9 * default;
+        if self.dynamic_rating_n == d.dynamic_rating_n {
+            if let (Some(own), Some(default)) =
+                (self.iso281_dynamic_rating_n(), d.iso281_dynamic_rating_n())
+            {
+                if moved(own, default) {
+                    self.dynamic_rating_n = own;
+                }
+            }
+        }
+        if self.static_rating_n == d.static_rating_n {
+            let (own, default) = (self.iso76_static_rating_n(), d.iso76_static_rating_n());
+            if moved(own, default) {
+                self.static_rating_n = own;
+            }
+        }
+        self
+    }
+
     /// ISO 281's basic dynamic radial load rating of this pair (N),
     /// `b_m f_c (i cos α)^0.7 Z^(2/3) D_w^1.8` with `D_w` in mm (`D_w <= 25.4 mm`).
     /// `None` if `γ` is outside the `f_c` range carried here or `D_w > 25.4 mm`.
@@ -590,16 +582,10 @@ mod tests {
         };
         let e = many.validate().unwrap_err().to_string();
         assert!(e.contains("pi * 0.051 / 200"), "{e}");
-        // Just fitting is allowed: 29 balls of 5.5 mm take 159.5 mm of 160.2 mm (with the
-        // pair's own ratings).
-        let fitting = BearingPair {
+        // Just fitting is allowed: 29 balls of 5.5 mm take 159.5 mm of 160.2 mm.
+        BearingPair {
             balls_per_row: 29,
             ..d.clone()
-        };
-        BearingPair {
-            dynamic_rating_n: fitting.iso281_dynamic_rating_n().unwrap(),
-            static_rating_n: fitting.iso76_static_rating_n(),
-            ..fitting
         }
         .validate()
         .unwrap();
@@ -612,44 +598,48 @@ mod tests {
         assert_eq!(e.field, "bearing.ball_diameter_m");
     }
 
-    /// Another geometry with the default pair's ratings is refused, naming the rating and the
-    /// value its formula gives (the damage and safety factors stayed at the default pair's
-    /// ratings whatever the geometry); with ratings of its own it is accepted.
+    /// Another geometry with the default pair's ratings takes its formulas' ratings; a rating
+    /// of its own (a catalogue's) is kept, and the default pair keeps the defaults.
     #[test]
-    fn another_geometry_needs_its_own_ratings() {
+    fn another_geometry_takes_its_own_ratings_unless_given() {
         let three_rows = BearingPair {
             rows: 3,
             ..BearingPair::default()
         };
-        let e = three_rows.validate().unwrap_err();
-        let c = three_rows.iso281_dynamic_rating_n().unwrap();
-        assert_eq!(e.field, "bearing.dynamic_rating_n");
-        assert!(
-            e.to_string()
-                .contains(&format!("ISO 281 gives {} N for it", approx(c))),
-            "{e}"
+        three_rows.validate().unwrap();
+        let run = three_rows.clone().with_ratings_of_its_geometry();
+        assert_eq!(
+            run.dynamic_rating_n,
+            three_rows.iso281_dynamic_rating_n().unwrap()
         );
-        let e = BearingPair {
-            dynamic_rating_n: c,
-            ..three_rows.clone()
-        }
-        .validate()
-        .unwrap_err();
-        assert_eq!(e.field, "bearing.static_rating_n");
-        BearingPair {
+        assert_eq!(run.static_rating_n, three_rows.iso76_static_rating_n());
+        assert!(run.dynamic_rating_n > 25_000.0 && run.static_rating_n > 30_000.0);
+        let catalogue = BearingPair {
             dynamic_rating_n: 25_000.0,
-            static_rating_n: 30_000.0,
             ..three_rows
         }
-        .validate()
-        .unwrap();
-        // The default pair, and a default geometry with a catalogue rating, pass.
-        BearingPair::default().validate().unwrap();
-        BearingPair {
-            dynamic_rating_n: 17_800.0,
+        .with_ratings_of_its_geometry();
+        assert_eq!(catalogue.dynamic_rating_n, 25_000.0);
+        assert_eq!(
+            BearingPair::default().with_ratings_of_its_geometry(),
+            BearingPair::default()
+        );
+        // A conformity ISO 281 does not depend on keeps C; ISO 76's C0 moves.
+        let conformity = BearingPair {
+            inner_conformity: 0.515,
+            ..BearingPair::default()
+        }
+        .with_ratings_of_its_geometry();
+        assert_eq!(conformity.dynamic_rating_n, 19_470.0);
+        // Balls beyond ISO 281's formula with the default rating: refused, with the reason.
+        let e = BearingPair {
+            ball_diameter_m: 0.03,
+            pitch_diameter_m: 0.3,
             ..BearingPair::default()
         }
         .validate()
-        .unwrap();
+        .unwrap_err();
+        assert_eq!(e.field, "bearing.dynamic_rating_n");
+        assert!(e.to_string().contains("does not cover it"), "{e}");
     }
 }

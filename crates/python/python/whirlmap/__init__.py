@@ -324,8 +324,14 @@ def critical(
     )
     rows: List[Dict[str, Any]] = json.loads(text)
     def unsettled(r: Dict[str, Any]) -> int:
+        # The unsettled drops that could hide the onset: below it, or any without one.
         probes = list(r.get("scan", [])) + list(r.get("bisections", []))
-        return sum(1 for p in probes if p.get("class") == "unresolved")
+        onset = r.get("onset_rpm")
+        return sum(
+            1
+            for p in probes
+            if p.get("class") == "unresolved" and (onset is None or p["speed_rpm"] < onset)
+        )
 
     undecided = [
         f"mu {r['mu']} ({r['failed_drops']} of {r['drops']} drops failed"
