@@ -322,7 +322,10 @@ def test_a_simulation_error_crosses_process_boundaries() -> None:
 @contextlib.contextmanager
 def _interrupt_after(seconds: float) -> Iterator[None]:
     """A SIGINT to this process after `seconds`, as Ctrl-C in a terminal sends it; never
-    later than the block."""
+    later than the block. Python's own SIGINT handler is installed for the block: a process
+    started in the background by a non-interactive shell (a CI job) inherits SIGINT ignored,
+    and Python then installs none."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(seconds, os.kill, (os.getpid(), signal.SIGINT))
     timer.start()
     try:
@@ -330,6 +333,7 @@ def _interrupt_after(seconds: float) -> Iterator[None]:
     finally:
         timer.cancel()
         timer.join()
+        signal.signal(signal.SIGINT, previous)
 
 
 def test_ctrl_c_stops_a_sweep_before_its_end() -> None:
