@@ -282,7 +282,8 @@ pub struct Scene {
     /// carried (duty of at least `classification.min_duty` within the turn), after which a
     /// run is stopped as decided whirl: backward whirl grows without bound in a rigid
     /// housing, so a whirl run needs a stopping rule. Turns made before the rotor settles
-    /// (a transient whirl that dies out) do not count. Default 5. Allowed [1, 1e6].
+    /// (a transient whirl that dies out) do not count. Default 5. Allowed [1, 1e6], a whole
+    /// number.
     pub whirl_stop_turns: f64,
     /// How a drop's orbit is classified and how long an undecided run is extended
     /// ([`ClassifyParams`]).
@@ -697,8 +698,10 @@ impl Scene {
         check(
             "whirl_stop_turns",
             self.whirl_stop_turns,
-            self.whirl_stop_turns >= 1.0 && self.whirl_stop_turns <= 1e6,
-            "[1, 1e6]",
+            self.whirl_stop_turns >= 1.0
+                && self.whirl_stop_turns <= 1e6
+                && self.whirl_stop_turns.fract() == 0.0,
+            "[1, 1e6], a whole number (whole turns are counted: 2.5 ran as 3)",
         )?;
         let s = &self.solver;
         check(
