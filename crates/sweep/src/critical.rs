@@ -468,11 +468,15 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
             fmt_rpm(ok[ok.len() - 1].0)
         ));
     }
-    let unresolved = scan
+    // The drops that did not settle (their speeds): counted here, and below the onset they
+    // leave it undecided.
+    let unsettled_speeds: Vec<f64> = scan
         .iter()
         .chain(transitions.iter().flat_map(|t| &t.probes))
         .filter(|p| p.class == Some(OrbitClass::Unresolved))
-        .count();
+        .map(|p| p.speed_rpm)
+        .collect();
+    let unresolved = unsettled_speeds.len();
     if unresolved > 0 {
         notes.push(format!(
             "{unresolved} unresolved drop(s) counted as no whirl in the intervals"
@@ -506,12 +510,6 @@ fn assemble(o: &CriticalOptions, scan: Vec<Probe>, transitions: Vec<Transition>)
     let hiding = hiding_failures(onset, &failed_speeds);
     // So could drops below it that did not settle: an unresolved motion may be a whirl the
     // classifier could not name (a backward whirl with intermittent contact).
-    let unsettled_speeds: Vec<f64> = scan
-        .iter()
-        .chain(transitions.iter().flat_map(|t| &t.probes))
-        .filter(|p| p.class == Some(OrbitClass::Unresolved))
-        .map(|p| p.speed_rpm)
-        .collect();
     let unsettled = hiding_failures(onset, &unsettled_speeds);
     if !ok.is_empty() && !unsettled.is_empty() {
         notes.insert(

@@ -8,6 +8,7 @@
 use crate::cancel::Cancel;
 use crate::critical::{drop_outcome, CriticalRow, Outcome};
 use rayon::prelude::*;
+use whirlmap_core::classify::OrbitClass;
 use whirlmap_core::{DropOptions, Fidelity, Scene};
 
 pub use whirlmap_results::critical::Recheck;
@@ -63,7 +64,8 @@ fn recheck_with(
     let (out_lo, out_hi) = rayon::join(|| run(&s, lo), || run(&s, hi));
     // A settled class below: an unresolved drop is no confirmation (below an onset it
     // leaves a search undecided).
-    let settled_below = matches!(&out_lo, Outcome::Class(c) if !c.is_whirl() && *c != whirlmap_core::classify::OrbitClass::Unresolved);
+    let settled_below =
+        matches!(&out_lo, Outcome::Class(c) if !c.is_whirl() && *c != OrbitClass::Unresolved);
     let confirmed = settled_below && out_hi.whirl() == Some(true);
     Some(Recheck {
         fidelity: tighter,
