@@ -9,7 +9,7 @@ use crate::point::{load_points, PointRow, PointStatus, MU_KEYS, SPEED_KEYS};
 use std::fmt::Write as _;
 use std::path::Path;
 use whirlmap_core::bearing::{assumptions, BearingPair};
-use whirlmap_core::{Scene, MODEL_VERSION};
+use whirlmap_core::Scene;
 
 /// What the report needs of a sweep's spec.
 #[derive(Debug, Clone, PartialEq)]
@@ -86,9 +86,22 @@ pub fn report(spec: &ReportSpec, pair: &BearingPair, rows: &[PointRow]) -> Strin
         .filter(|c| spec.charts.iter().any(|s| s == *c))
         .map(|c| format!("`charts/{c}`"))
         .collect();
+    // The version that ran the records (a report drawn again from older records names
+    // theirs, not the binary's).
+    let mut versions: Vec<u64> = rows.iter().filter_map(|r| r.model_version).collect();
+    versions.sort_unstable();
+    versions.dedup();
+    let version = match versions.as_slice() {
+        [] => "model version not recorded".to_string(),
+        [v] => format!("model version {v}"),
+        vs => format!(
+            "model versions {}",
+            vs.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")
+        ),
+    };
     let _ = writeln!(
         w,
-        "{} drops of {} s each (model version {MODEL_VERSION}): {counts}. Every drop is in \
+        "{} drops of {} s each ({version}): {counts}. Every drop is in \
          `summary.csv`{}.\n",
         rows.len(),
         spec.duration_s,
@@ -404,7 +417,10 @@ mod tests {
             line(2, "failed", r#", "error": {"kind": "x", "message": "y"}"#),
         ];
         let text = report(&spec, &pair, &rows);
-        assert!(text.contains("3 drops of 0.1 s each"), "{text}");
+        assert!(
+            text.contains("3 drops of 0.1 s each (model version not recorded)"),
+            "{text}"
+        );
         assert!(
             text.contains("2 ran, 1 failed (no bearing results), 1 never loaded the bearing"),
             "{text}"
@@ -439,8 +455,19 @@ mod tests {
         // The axes: one over the bearing is said.
         let varied = ReportSpec {
             axes: vec!["bearing.balls_per_row".to_string()],
-            ..spec
+            ..spec.clone()
         };
         assert!(report(&varied, &pair, &rows).contains("The sweep varies bearing.balls_per_row"));
+        // The model version is the records' (a report drawn again from older records names
+        // theirs), and two are both named.
+        let versioned = |v: u64| {
+            let mut r = rows[0].clone();
+            r.model_version = Some(v);
+            r
+        };
+        let text = report(&spec, &pair, &[versioned(7), versioned(7)]);
+        assert!(text.contains("(model version 7)"), "{text}");
+        let text = report(&spec, &pair, &[versioned(8), versioned(7)]);
+        assert!(text.contains("(model versions 7, 8)"), "{text}");
     }
 }

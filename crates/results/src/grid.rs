@@ -157,6 +157,7 @@ mod tests {
             whirl_stop_turns: None,
             error: None,
             duration_s: None,
+            model_version: None,
         };
         let rows = vec![
             row(3, 1000.0, 0.1, 2e-4),

@@ -128,6 +128,9 @@ pub struct PointLine {
     /// Simulated time asked for (s).
     #[serde(default)]
     pub duration_s: Option<f64>,
+    /// The model version that ran the point.
+    #[serde(default)]
+    pub model_version: Option<u64>,
 }
 
 impl PointLine {
@@ -185,6 +188,8 @@ pub struct PointRow {
     pub error: Option<String>,
     /// Simulated time asked for (s), when the record says.
     pub duration_s: Option<f64>,
+    /// The model version that ran the point, when the line says.
+    pub model_version: Option<u64>,
 }
 
 impl PointRow {
@@ -253,6 +258,7 @@ impl From<PointLine> for PointRow {
                 .map(f64::abs),
             error,
             duration_s: r.duration_s,
+            model_version: r.model_version,
         }
     }
 }
