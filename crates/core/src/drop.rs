@@ -19,6 +19,10 @@ use std::ops::ControlFlow;
 /// Version of the model and its outputs; part of every record key. Bump it when a change
 /// alters results for the same scene.
 ///
+/// - 8: a guard at or below zero right after a mode switch (two guards crossing together,
+///   or a switch that moves another guard) takes its own switch (`take_follow_on_jumps` in
+///   `ode/hybrid.rs`); a race without gravity starts on its support; a contact stepped over
+///   ends the drop with the typed `unphysical` error.
 /// - 7: the `standard` numerics widen the race's velocity tolerance in loaded contact to
 ///   `rtol F_n / max(c1, c2)` (`solver.race_velocity_atol_from_force`), where the race's
 ///   velocity had set RODAS4's step, and hold every other race tolerance to the rotor's
@@ -38,7 +42,7 @@ use std::ops::ControlFlow;
 ///   classes describe the settled motion on a final window, undecided runs are extended,
 ///   and the whirl rule counts consecutive carried turns ([`crate::classify`]).
 /// - 2: a slip entered against the drifted slip velocity takes its sign.
-pub const MODEL_VERSION: u32 = 7;
+pub const MODEL_VERSION: u32 = 8;
 
 /// Largest first step after a mode switch (s): see [`Stepper::cap_next_step`].
 pub(crate) const STEP_AFTER_SWITCH_S: f64 = 1e-7;

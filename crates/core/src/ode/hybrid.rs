@@ -4,7 +4,7 @@
 
 use super::integrate::{integrate, NoObserver, Observer, Stop};
 use super::stepper::Stepper;
-use super::system::OdeSystem;
+use super::system::{GuardSet, OdeSystem, MAX_GUARDS};
 use crate::error::SolveError;
 
 /// A system with discrete modes: the mode it is in, and its jump map.
@@ -69,7 +69,10 @@ where
         match integrate(&*sys, stepper, t, y, t_end, observer)? {
             Stop::EndTime => return Ok(Finish::EndTime),
             Stop::Halted(halt) => return Ok(Finish::Halted(halt)),
-            Stop::Event { guard } => {
+            Stop::Event {
+                guard,
+                violated_before,
+            } => {
                 if stepper.stats().events >= rules.max_events {
                     return Err(SolveError::EventBudget {
                         t_s: *t,
@@ -80,8 +83,179 @@ where
                 let to = sys.jump(guard, y);
                 observer.on_jump(sys, *t, y, from, to);
                 sys.set_mode(to);
+                take_follow_on_jumps(sys, *t, y, guard, &violated_before, observer);
                 stepper.cap_next_step(rules.step_after_jump_s);
             }
         }
+    }
+}
+
+/// The jumps of the guards that are at or below zero right after a jump: those that crossed
+/// together with the located one, and those the jump itself sent there.
+///
+/// The driver watches a guard of a mode only once it is positive, so a guard that starts a
+/// mode at or below zero and stays there would never be seen, and the part of the mode it ends would hold with its
+/// guard violated. Two ways lead there:
+/// - **Guards that cross together.** When the friction of a sticking contact is exactly zero
+///   (a drop without spin), its friction guard `mu_s F_n - |F_t|` and the contact guard `F_n`
+///   vanish at once. The stick ended, the contact stayed closed and pulled the rotor with a
+///   negative normal force.
+/// - **A jump that moves another guard.** The isotropic support damper acts only while the
+///   race is on its balls, so when the race lifts off, the race's acceleration, and with it the
+///   friction that keeps a contact rolling (eq. 9), jumps. A stick that held its static limit
+///   (eq. 10) before the lift-off can exceed it after; it kept sticking.
+///
+/// So after the located jump, each guard of the new mode that is at or below zero at the jump's
+/// state (a crossing, as the driver counts one) takes its own jump, in slot order, each at
+/// most once, re-evaluated after every jump. A
+/// guard the first jump made irrelevant (the friction guard once the contact is open) has no
+/// slot in the new mode. A guard that was already violated when the step began
+/// (`violated_before`: a crossing stepped over earlier, which the model's own checks report)
+/// is left as it was.
+fn take_follow_on_jumps<S, O, const N: usize>(
+    sys: &mut S,
+    t: f64,
+    y: &[f64; N],
+    located: S::Guard,
+    violated_before: &[bool; MAX_GUARDS],
+    observer: &mut O,
+) where
+    S: Hybrid<N>,
+    O: HybridObserver<S, N>,
+{
+    let all = S::Guard::ALL;
+    let mut done = *violated_before;
+    if let Some(i) = all.iter().position(|g| *g == located) {
+        done[i] = true;
+    }
+    loop {
+        let mut g = [0.0; MAX_GUARDS];
+        let ng = sys.guards(t, y, &mut g);
+        let Some(j) = (0..ng).find(|&j| !done[j] && g[j] <= 0.0) else {
+            return;
+        };
+        done[j] = true;
+        let from = sys.mode();
+        let to = sys.jump(all[j], y);
+        observer.on_jump(sys, t, y, from, to);
+        sys.set_mode(to);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ode::{Dopri5, StepControl};
+
+    /// Two latches over a falling coordinate `y' = -1` from `y = 1`. Latch A opens when its
+    /// guard `y - a_at` reaches zero; latch B's guard is `y - b_at`, or `b_after_a` once A is
+    /// open if that is given (a switch that moves another guard).
+    struct Latches {
+        a_at: f64,
+        b_at: f64,
+        b_after_a: Option<f64>,
+        mode: (bool, bool),
+    }
+
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    enum Latch {
+        A,
+        B,
+    }
+
+    impl GuardSet for Latch {
+        const ALL: &'static [Self] = &[Latch::A, Latch::B];
+    }
+
+    impl OdeSystem<1> for Latches {
+        type Guard = Latch;
+        fn rhs(&self, _t: f64, _y: &[f64; 1], dy: &mut [f64; 1]) {
+            dy[0] = -1.0;
+        }
+        fn guards(&self, _t: f64, y: &[f64; 1], g: &mut [f64; MAX_GUARDS]) -> usize {
+            let (a, b) = self.mode;
+            g[0] = if a { y[0] - self.a_at } else { 1.0 };
+            g[1] = match (b, a, self.b_after_a) {
+                (false, _, _) => 1.0,
+                (true, false, Some(after)) => after,
+                (true, _, _) => y[0] - self.b_at,
+            };
+            2
+        }
+        fn max_step(&self) -> f64 {
+            0.05
+        }
+    }
+
+    impl Hybrid<1> for Latches {
+        type Mode = (bool, bool);
+        fn mode(&self) -> (bool, bool) {
+            self.mode
+        }
+        fn set_mode(&mut self, mode: (bool, bool)) {
+            self.mode = mode;
+        }
+        fn jump(&self, guard: Latch, _y: &[f64; 1]) -> (bool, bool) {
+            match guard {
+                Latch::A => (false, self.mode.1),
+                Latch::B => (self.mode.0, false),
+            }
+        }
+    }
+
+    /// The mode at t = 1 (y = 0) after starting with both latches closed.
+    fn run(a_at: f64, b_at: f64, b_after_a: Option<f64>) -> (bool, bool) {
+        let mut sys = Latches {
+            a_at,
+            b_at,
+            b_after_a,
+            mode: (true, true),
+        };
+        let ctl = StepControl {
+            rtol: 1e-9,
+            atol: [1e-12],
+            h_min: 1e-14,
+            max_attempts: 10_000,
+            fixed_step: None,
+        };
+        let mut stepper = Dopri5::new(ctl);
+        let (mut t, mut y) = (0.0, [1.0]);
+        let rules = JumpRules {
+            max_events: 10,
+            step_after_jump_s: 1e-3,
+        };
+        run_hybrid(
+            &mut sys,
+            &mut stepper,
+            &mut t,
+            &mut y,
+            1.0,
+            &mut NoObserver,
+            &rules,
+        )
+        .unwrap();
+        sys.mode
+    }
+
+    #[test]
+    fn guards_that_cross_together_both_switch() {
+        // Both guards are y - 0.5: one crossing is located, the other must switch with it.
+        assert_eq!(run(0.5, 0.5, None), (false, false));
+        // Apart, each switches at its own crossing (and B stays closed if it never crosses).
+        assert_eq!(run(0.5, 0.25, None), (false, false));
+        assert_eq!(run(0.5, -1.0, None), (false, true));
+    }
+
+    #[test]
+    fn a_switch_that_sends_another_guard_negative_switches_it_too() {
+        // Opening A sends B's guard to -1 (B's own crossing at y = -1 is never reached).
+        assert_eq!(run(0.5, -1.0, Some(-1.0)), (false, false));
+    }
+
+    #[test]
+    fn a_guard_violated_when_the_step_began_is_left_alone() {
+        // B's guard is negative from the start (y - 2): a crossing stepped over before the
+        // run, which A's switch does not answer.
+        assert_eq!(run(0.5, 2.0, Some(-1.0)), (false, true));
     }
 }

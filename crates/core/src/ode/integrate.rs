@@ -40,6 +40,12 @@ pub enum Stop<G, H> {
     Event {
         /// Which guard of the mode fired.
         guard: G,
+        /// The guards (by slot, as in [`OdeSystem::guards`]) that were already `<= 0` both at
+        /// the start of the step and at the returned state: a violation the step began with
+        /// (a crossing stepped over before), not one it made. Every other guard that is at or
+        /// below zero after the jump crossed together with this one, or was sent there by the
+        /// jump itself ([`super::run_hybrid`] takes their jumps too).
+        violated_before: [bool; MAX_GUARDS],
     },
     /// The observer returned `ControlFlow::Break(halt)`.
     Halted(H),
@@ -111,11 +117,18 @@ where
                 let cut = stepper.cut_last_step(hi);
                 *t = hi;
                 *y = cut.y1();
+                let mut at_event = [0.0; MAX_GUARDS];
+                sys.guards(hi, y, &mut at_event);
+                let mut violated_before = [false; MAX_GUARDS];
+                for j in 0..ng {
+                    violated_before[j] = g0[j] <= 0.0 && at_event[j] <= 0.0;
+                }
                 let view = StepView { dense: cut };
                 // The observer sees the step up to the event; a break here is moot.
                 let _ = observer.on_step(sys, &view);
                 return Ok(Stop::Event {
                     guard: S::Guard::ALL[index],
+                    violated_before,
                 });
             }
             None => {
