@@ -1023,7 +1023,7 @@ impl Observer<DropSystem, N> for StickWatch {
 /// the race is on its balls, so at a lift-off the race's acceleration jumps, and with it the
 /// friction the rolling constraint needs (eq. 9). Before the driver took the jumps of guards
 /// sent negative by a jump, a stick whose demand jumped past the limit went on sticking:
-/// 0.8 N over it in one of the main job's probability members (2000 r/min, mu 0.45, the
+/// 0.72 N over it in one of the main job's probability members (2000 r/min, mu 0.45, the
 /// drawn release below), which this test replays at the default numerics, with two grid cells.
 #[test]
 fn sticking_friction_stays_within_the_static_limit() {
