@@ -6,8 +6,9 @@
 //! the only energy is the small drop energy m g s, so the relative residual is largest) at
 //! the scene's tolerance, at rtol 1e-3 and 1e-2 (the loosest a scene allows), and with the
 //! draft preset (with and without spin), and prints each residual and the largest per
-//! setting (`--quick`: without the 60 s drops). A drop whose audit fails reports its residual from the
-//! typed error, so the measurement does not depend on the threshold.
+//! setting (`--quick`: the reduced matrix of the CI test, drops of 10-30 ms). A drop whose
+//! audit fails reports its residual from the typed error, so the measurement does not depend
+//! on the threshold.
 
 use whirlmap_core::{simulate, DropOptions, Scene, SolveError};
 use whirlmap_sweep::extremes::matrix;
