@@ -19,9 +19,8 @@ use std::ops::ControlFlow;
 /// Version of the model and its outputs; part of every record key. Bump it when a change
 /// alters results for the same scene.
 ///
-/// - 8: a guard at or below zero right after a mode switch (two guards crossing together,
-///   or a switch that moves another guard) takes its own switch (`take_follow_on_jumps` in
-///   `ode/hybrid.rs`); a race without gravity starts on its support; a contact stepped over
+/// - 8: a guard that crossed together with the located one, or that a mode switch sent
+///   below zero, takes its own switch (`take_follow_on_jumps` in `ode/hybrid.rs`); a race without gravity starts on its support; a contact stepped over
 ///   ends the drop with the typed `unphysical` error.
 /// - 7: the `standard` numerics widen the race's velocity tolerance in loaded contact to
 ///   `rtol F_n / max(c1, c2)` (`solver.race_velocity_atol_from_force`), where the race's

@@ -71,6 +71,7 @@ where
             Stop::Halted(halt) => return Ok(Finish::Halted(halt)),
             Stop::Event {
                 guard,
+                crossed,
                 violated_before,
             } => {
                 if stepper.stats().events >= rules.max_events {
@@ -83,19 +84,19 @@ where
                 let to = sys.jump(guard, y);
                 observer.on_jump(sys, *t, y, from, to);
                 sys.set_mode(to);
-                take_follow_on_jumps(sys, *t, y, guard, &violated_before, observer);
+                take_follow_on_jumps(sys, *t, y, guard, &crossed, &violated_before, observer);
                 stepper.cap_next_step(rules.step_after_jump_s);
             }
         }
     }
 }
 
-/// The jumps of the guards that are at or below zero right after a jump: those that crossed
-/// together with the located one, and those the jump itself sent there.
+/// The jumps of the guards that crossed together with the located one, and of those the jump
+/// itself sent below zero.
 ///
 /// The driver watches a guard of a mode only once it is positive, so a guard that starts a
-/// mode at or below zero and stays there would never be seen, and the part of the mode it ends would hold with its
-/// guard violated. Two ways lead there:
+/// mode at or below zero and stays there would never be seen, and the part of the mode it ends
+/// would hold with its guard violated. Two ways lead there:
 /// - **Guards that cross together.** When the friction of a sticking contact is exactly zero
 ///   (a drop without spin), its friction guard `mu_s F_n - |F_t|` and the contact guard `F_n`
 ///   vanish at once. The stick ended, the contact stayed closed and pulled the rotor with a
@@ -105,18 +106,22 @@ where
 ///   friction that keeps a contact rolling (eq. 9), jumps. A stick that held its static limit
 ///   (eq. 10) before the lift-off can exceed it after; it kept sticking.
 ///
-/// So after the located jump, each guard of the new mode that is at or below zero at the jump's
-/// state (a crossing, as the driver counts one) takes its own jump, in slot order, each at
-/// most once, re-evaluated after every jump. A
-/// guard the first jump made irrelevant (the friction guard once the contact is open) has no
-/// slot in the new mode. A guard that was already violated when the step began
-/// (`violated_before`: a crossing stepped over earlier, which the model's own checks report)
-/// is left as it was.
+/// So after the located jump, in slot order, each at most once and re-evaluated after every
+/// jump, a guard of the new mode takes its own jump when it is at or below zero and crossed
+/// in the step (`crossed`: a crossing, as the driver counts one), or when it is below zero
+/// otherwise. A guard exactly at zero that did not cross is a boundary the jump map itself
+/// decided: a contact entered with no force yet (an undamped contact starts at `F_n = 0`) sticks
+/// with a friction guard `mu_s F_n - |F_t|` of exactly 0 when no friction is needed; switching it
+/// to a slip there would start a slip whose own guard is 0 and never watched. A guard the
+/// first jump made irrelevant (the friction guard once the contact is open) has no slot in the
+/// new mode. A guard that was already violated when the step began (`violated_before`: a
+/// crossing stepped over earlier, which the model's own checks report) is left as it was.
 fn take_follow_on_jumps<S, O, const N: usize>(
     sys: &mut S,
     t: f64,
     y: &[f64; N],
     located: S::Guard,
+    crossed: &[bool; MAX_GUARDS],
     violated_before: &[bool; MAX_GUARDS],
     observer: &mut O,
 ) where
@@ -131,7 +136,8 @@ fn take_follow_on_jumps<S, O, const N: usize>(
     loop {
         let mut g = [0.0; MAX_GUARDS];
         let ng = sys.guards(t, y, &mut g);
-        let Some(j) = (0..ng).find(|&j| !done[j] && g[j] <= 0.0) else {
+        let Some(j) = (0..ng).find(|&j| !done[j] && (g[j] < 0.0 || (crossed[j] && g[j] <= 0.0)))
+        else {
             return;
         };
         done[j] = true;
@@ -250,6 +256,8 @@ mod tests {
     fn a_switch_that_sends_another_guard_negative_switches_it_too() {
         // Opening A sends B's guard to -1 (B's own crossing at y = -1 is never reached).
         assert_eq!(run(0.5, -1.0, Some(-1.0)), (false, false));
+        // Sent exactly to zero without crossing: a boundary the jump decided, left alone.
+        assert_eq!(run(0.5, -1.0, Some(0.0)), (false, true));
     }
 
     #[test]

@@ -40,11 +40,13 @@ pub enum Stop<G, H> {
     Event {
         /// Which guard of the mode fired.
         guard: G,
-        /// The guards (by slot, as in [`OdeSystem::guards`]) that were already `<= 0` both at
-        /// the start of the step and at the returned state: a violation the step began with
-        /// (a crossing stepped over before), not one it made. Every other guard that is at or
-        /// below zero after the jump crossed together with this one, or was sent there by the
-        /// jump itself ([`super::run_hybrid`] takes their jumps too).
+        /// The other guards (by slot, as in [`OdeSystem::guards`]) that crossed in the same
+        /// step: positive at its start and `<= 0` at the returned state, so at the same
+        /// instant to the locator's resolution ([`super::run_hybrid`] takes their jumps too).
+        crossed: [bool; MAX_GUARDS],
+        /// The guards that were already `<= 0` both at the start of the step and at the
+        /// returned state: a violation the step began with (a crossing stepped over before),
+        /// not one it made.
         violated_before: [bool; MAX_GUARDS],
     },
     /// The observer returned `ControlFlow::Break(halt)`.
@@ -119,8 +121,10 @@ where
                 *y = cut.y1();
                 let mut at_event = [0.0; MAX_GUARDS];
                 sys.guards(hi, y, &mut at_event);
+                let mut crossed = [false; MAX_GUARDS];
                 let mut violated_before = [false; MAX_GUARDS];
                 for j in 0..ng {
+                    crossed[j] = j != index && g0[j] > 0.0 && at_event[j] <= 0.0;
                     violated_before[j] = g0[j] <= 0.0 && at_event[j] <= 0.0;
                 }
                 let view = StepView { dense: cut };
@@ -128,6 +132,7 @@ where
                 let _ = observer.on_step(sys, &view);
                 return Ok(Stop::Event {
                     guard: S::Guard::ALL[index],
+                    crossed,
                     violated_before,
                 });
             }
