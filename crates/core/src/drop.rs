@@ -178,13 +178,13 @@ fn check_physical(sys: &DropSystem, y: &[f64; N], t: f64) -> Result<(), SolveErr
 /// 2.1e-5 at the scenes' own tolerances (the default RODAS4 at rtol 3e-5 with the race's
 /// velocity tolerance from the contact force; version 6 gave 8.5e-6, version 5's DOPRI5
 /// 2.9e-4), 7.1e-4 at rtol 1e-3, 0.12 at rtol 1e-2, the loosest a scene allows; 4.3e-3 with
-/// the `draft` preset and 0.21 with it at no spin and no damping.
+/// the `draft` preset and 0.20 with it at no spin and no damping (30 ms).
 /// Drops whose books are broken, with energy created (negative losses, e.g. the race's
 /// absolute tolerance loosened 1e4-fold under the explicit DOPRI5 stepper at no spin),
 /// measured 1.0 to 1.7, as did a rotor inertia of 1e-300 kg m^2 that validation now
 /// refuses. 0.5 lies between the two. An undamped drop without spin at the `draft` preset
 /// crosses it over a full second: the L-stable stepper damps the undamped contact
-/// oscillations numerically and loses 0.66 of the fall's energy, so that drop fails, rightly,
+/// oscillations numerically and loses 0.91 of the fall's energy, so that drop fails, rightly,
 /// since its numbers are not to be trusted; version 5's default numerics closed the same drop
 /// to 2.8e-2 (docs/accuracy.md#energy-audit).
 pub const AUDIT_THRESHOLD: f64 = 0.5;
