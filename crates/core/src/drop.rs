@@ -168,6 +168,31 @@ fn check_physical(sys: &DropSystem, y: &[f64; N], t: f64) -> Result<(), SolveErr
     Ok(())
 }
 
+/// Friction only dissipates (eq. 17's H_s = F_t v_rel is never negative in slip, and is zero
+/// in stick but for the drift of v_rel), so a drop whose friction heat ends below zero by more
+/// than [`AUDIT_THRESHOLD`] of its initial energy (or of the drop energy m g s, if larger)
+/// has had friction make energy, which the audit cannot see: it checks that the books
+/// balance, and they do. A safety net, far outside integration error (a sticking contact's
+/// drift gives heat dips below 1e-6 J in the physics tests): a wrong mode switch that left a
+/// slip pushing along its own slip velocity made -1788 J of "friction heat" in a drop without
+/// spin, whose only energy was the fall's 8.5 mJ, and the audit passed
+/// (docs/model.md#guards-that-reach-zero-at-a-switch).
+fn check_friction_heat(energy: &EnergyAudit, drop_energy_j: f64, t: f64) -> Result<(), SolveError> {
+    let scale = energy.initial_j.abs().max(drop_energy_j);
+    if energy.friction_heat_j < -AUDIT_THRESHOLD * scale {
+        return Err(SolveError::Unphysical {
+            t_s: t,
+            what: format!(
+                "the friction heat is {:.6e} J, below zero by more than {AUDIT_THRESHOLD} of the \
+                 larger of the initial energy and the drop energy m g s ({:.6e} J): friction \
+                 made energy",
+                energy.friction_heat_j, scale
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The largest energy audit residual a drop may have ([`EnergyAudit::residual_rel`]); above
 /// it the drop fails with [`SolveError::EnergyAudit`].
 ///
@@ -549,7 +574,8 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
     }
     let e1 = sys.mechanical_energy(&y, sys.mode);
     let (fric, damp, drag) = (y[ix::E_FRIC], y[ix::E_DAMP] + switch_loss, y[ix::E_DRAG]);
-    let energy = EnergyAudit::new(e0, e1, fric, damp, drag, sys.weight_n() * scene.clearance_m);
+    let drop_energy_j = sys.weight_n() * scene.clearance_m;
+    let energy = EnergyAudit::new(e0, e1, fric, damp, drag, drop_energy_j);
     if !(energy.residual_rel <= AUDIT_THRESHOLD) {
         return Err(SolveError::EnergyAudit {
             t_s: t,
@@ -561,6 +587,7 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
         });
     }
     check_physical(&sys, &y, t)?;
+    check_friction_heat(&energy, drop_energy_j, t)?;
     let (features, orbit) = mon.finish(&sys, t, &y);
     let verdict = classify(&features, stop_reason, cls);
     let thermal = thermal.map(|th| th.finish(t, &y));
@@ -612,5 +639,28 @@ mod tests {
             let a = EnergyAudit::new(1.0, 1.0, 0.0, 0.0, 0.0, bad);
             assert_eq!(a.residual_rel, f64::INFINITY);
         }
+    }
+
+    #[test]
+    fn friction_that_made_energy_fails_even_when_the_books_balance() {
+        // The wrong switch's drop without spin: the fall's 8.5 mJ, -1788 J of friction heat,
+        // and the books balanced.
+        let (e0, heat) = (-4.3e-8, -1788.0);
+        let a = EnergyAudit::new(e0, e0 - heat - 0.5, heat, 0.5, 0.0, 8.5e-3);
+        assert!(a.residual_rel < 1e-12, "{a:?}");
+        match check_friction_heat(&a, 8.5e-3, 1.0) {
+            Err(e @ SolveError::Unphysical { .. }) => {
+                assert!(e.to_string().contains("friction made energy"), "{e}")
+            }
+            other => panic!("{other:?}"),
+        }
+        // A dip of integration error passes, in a spinning drop (scaled by its 1019 J) and in
+        // one without spin (scaled by m g s); half the scale below zero does not.
+        let a = EnergyAudit::new(1018.7, 1018.7 + 1e-6, -1e-6, 0.0, 0.0, 8.5e-3);
+        assert!(check_friction_heat(&a, 8.5e-3, 1.0).is_ok());
+        let a = EnergyAudit::new(0.0, -8.5e-3 + 1e-5, -1e-5, 8.5e-3, 0.0, 8.5e-3);
+        assert!(check_friction_heat(&a, 8.5e-3, 1.0).is_ok());
+        let a = EnergyAudit::new(0.0, -8.5e-3 + 1e-2, -1e-2, 8.5e-3, 0.0, 8.5e-3);
+        assert!(check_friction_heat(&a, 8.5e-3, 1.0).is_err());
     }
 }

@@ -82,9 +82,10 @@ pub enum SolveError {
         /// Friction heat, damping loss and drag work (J).
         losses_j: f64,
     },
-    /// The drop ended in a state the physics rules out, which an energy audit scaled by a
-    /// large spin energy can miss: the rotor through the race with the contact not acting
-    /// (a contact stepped over). The results of such a drop are not trustworthy.
+    /// The drop ended in a state the physics rules out, which the energy audit can miss: the
+    /// rotor through the race with the contact not acting (a contact stepped over), or friction
+    /// heat far below zero (friction made energy). The results of such a drop are not
+    /// trustworthy.
     #[error(
         "unphysical result at t = {t_s:.9} s: {what}; the numerics missed the contact's \
          dynamics: run the drop at a tighter tolerance (solver.rtol) or fidelity"
