@@ -20,8 +20,10 @@ use std::ops::ControlFlow;
 /// alters results for the same scene.
 ///
 /// - 8: a guard that crossed together with the located one, or that a mode switch sent
-///   below zero, takes its own switch (`take_follow_on_jumps` in `ode/hybrid.rs`); a race without gravity starts on its support; a contact stepped over
-///   ends the drop with the typed `unphysical` error.
+///   below zero, takes its own switch (`take_follow_on_jumps` in `ode/hybrid.rs`); a race
+///   without gravity starts on its support; a contact stepped over, or friction heat below
+///   zero by more than half the drop's energy, ends the drop with the typed `unphysical`
+///   error.
 /// - 7: the `standard` numerics widen the race's velocity tolerance in loaded contact to
 ///   `rtol F_n / max(c1, c2)` (`solver.race_velocity_atol_from_force`), where the race's
 ///   velocity had set RODAS4's step, and hold every other race tolerance to the rotor's
