@@ -80,10 +80,7 @@ where
                         events: stepper.stats().events,
                     });
                 }
-                let from = sys.mode();
-                let to = sys.jump(guard, y);
-                observer.on_jump(sys, *t, y, from, to);
-                sys.set_mode(to);
+                switch(sys, guard, *t, y, observer);
                 take_follow_on_jumps(sys, *t, y, guard, &crossed, &violated_before, observer);
                 stepper.cap_next_step(rules.step_after_jump_s);
             }
@@ -141,11 +138,26 @@ fn take_follow_on_jumps<S, O, const N: usize>(
             return;
         };
         done[j] = true;
-        let from = sys.mode();
-        let to = sys.jump(all[j], y);
-        observer.on_jump(sys, t, y, from, to);
-        sys.set_mode(to);
+        switch(sys, all[j], t, y, observer);
     }
+}
+
+/// One jump: the mode the jump map gives for `guard` at `(t, y)`, shown to the observer, then
+/// taken.
+fn switch<S, O, const N: usize>(
+    sys: &mut S,
+    guard: S::Guard,
+    t: f64,
+    y: &[f64; N],
+    observer: &mut O,
+) where
+    S: Hybrid<N>,
+    O: HybridObserver<S, N>,
+{
+    let from = sys.mode();
+    let to = sys.jump(guard, y);
+    observer.on_jump(sys, t, y, from, to);
+    sys.set_mode(to);
 }
 
 #[cfg(test)]
