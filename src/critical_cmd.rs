@@ -233,6 +233,8 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                 fmt_rpm(hi),
                 if r.undecided {
                     ", UNDECIDED: failed drops below it"
+                } else if r.recheck.as_ref().is_some_and(|rc| !rc.confirmed) {
+                    ", NOT CONFIRMED by the re-check"
                 } else if r.converged {
                     ""
                 } else {

@@ -388,6 +388,13 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
     assert_eq!(o.status.code(), Some(1), "{}", out(&o));
     let rows: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
     assert_eq!(rows[0]["recheck"]["confirmed"], false, "{rows}");
+    // The row itself says it, for the CSV (no re-check columns) and whoever reads only it.
+    assert_eq!(rows[0]["converged"], false, "{rows}");
+    let note = rows[0]["note"].as_str().expect("a note");
+    assert!(
+        note.starts_with("NOT CONFIRMED by the re-check at standard: "),
+        "{note}"
+    );
     let err = stderr(&o);
     assert!(
         err.contains("does not confirm the onset at mu 0.25 (at standard:")
@@ -401,6 +408,14 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
     assert_eq!(o.status.code(), Some(0), "{}", out(&o));
     let rows: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
     assert_eq!(rows[0]["recheck"]["confirmed"], true, "{rows}");
+    assert_eq!(rows[0]["converged"], true, "{rows}");
+    assert!(
+        !rows[0]["note"]
+            .as_str()
+            .expect("a note")
+            .contains("CONFIRMED"),
+        "{rows}"
+    );
 }
 
 #[test]

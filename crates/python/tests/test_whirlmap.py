@@ -218,6 +218,8 @@ def test_critical_warns_when_the_re_check_does_not_confirm_the_onset() -> None:
             fidelity="draft",
         )  # fmt: skip
     assert rows[0]["recheck"]["confirmed"] is False
+    assert rows[0]["converged"] is False
+    assert rows[0]["note"].startswith("NOT CONFIRMED by the re-check at standard: ")
 
 
 def test_critical_checks_before_running() -> None:

@@ -91,8 +91,9 @@ pub struct CriticalRow {
     pub drops: usize,
     /// Drops that failed (counted as neither class; see `scan` and `bisections`).
     pub failed_drops: usize,
-    /// Every bisection reached `tol_rpm` and no failed drop leaves the onset undecided
-    /// (false whenever `undecided` is true).
+    /// Every bisection reached `tol_rpm`, no failed drop leaves the onset undecided (false
+    /// whenever `undecided` is true) and, when the bracket was re-checked at a tighter
+    /// preset, the re-check confirmed it ([`Recheck::apply_to`]).
     pub converged: bool,
     /// Failed drops leave the onset undecided: every scan drop failed, or a drop failed
     /// below the reported onset (inside its bracket included), where a whirl would have
@@ -212,23 +213,11 @@ pub fn undecided_summary(rows: &[CriticalRow]) -> Option<String> {
 /// re-checked. The command line then exits 1, as the Python package warns: the onset the
 /// search's own preset found is not the tighter preset's.
 pub fn unconfirmed_summary(rows: &[CriticalRow]) -> Option<String> {
-    let show = |o: &Outcome| match o {
-        Outcome::Class(c) => c.name().to_string(),
-        Outcome::Failed(_) => "failed".to_string(),
-    };
     let list: Vec<String> = rows
         .iter()
         .filter_map(|r| {
             let rc = r.recheck.as_ref().filter(|rc| !rc.confirmed)?;
-            Some(format!(
-                "mu {} (at {}: {} r/min {}, {} r/min {})",
-                r.mu,
-                rc.fidelity,
-                rc.lo.0,
-                show(&rc.lo.1),
-                rc.hi.0,
-                show(&rc.hi.1)
-            ))
+            Some(format!("mu {} ({})", r.mu, rc.outcomes()))
         })
         .collect();
     (!list.is_empty()).then(|| list.join(", "))
@@ -245,6 +234,41 @@ pub struct Recheck {
     pub hi: (f64, Outcome),
     /// True when the tighter preset also gives no whirl at `lo` and whirl at `hi`.
     pub confirmed: bool,
+}
+
+impl Recheck {
+    /// The two drops at the tighter preset, in words: `at standard: 13312.5 r/min
+    /// backward_whirl, 13375 r/min backward_whirl` (a failed drop reads `failed`).
+    pub fn outcomes(&self) -> String {
+        let show = |o: &Outcome| match o {
+            Outcome::Class(c) => c.name().to_string(),
+            Outcome::Failed(_) => "failed".to_string(),
+        };
+        format!(
+            "at {}: {} r/min {}, {} r/min {}",
+            self.fidelity,
+            self.lo.0,
+            show(&self.lo.1),
+            self.hi.0,
+            show(&self.hi.1)
+        )
+    }
+
+    /// Records this re-check in `row`. One the tighter preset does not confirm makes the row
+    /// not converged (its onset is the search preset's only) and puts `NOT CONFIRMED` and
+    /// the two drops ([`Recheck::outcomes`]) at the head of its note, so that `critical.csv`,
+    /// which has no re-check columns, says it too.
+    pub fn apply_to(self, row: &mut CriticalRow) {
+        if !self.confirmed {
+            row.converged = false;
+            row.note = format!(
+                "NOT CONFIRMED by the re-check {}; {}",
+                self.outcomes(),
+                row.note
+            );
+        }
+        row.recheck = Some(self);
+    }
 }
 
 /// The text of `critical.json` for `rows` (pretty JSON, no final newline).

@@ -27,7 +27,8 @@ pub fn recheck_bracket(
 }
 
 /// Re-checks every row's bracket ([`recheck_bracket`]) at `tighter`, the rows at once, each
-/// on `base` with the row's friction coefficient. With `cancel`, a drop not yet started
+/// on `base` with the row's friction coefficient, and records each in its row
+/// ([`Recheck::apply_to`]: an unconfirmed bracket leaves the row not converged). With `cancel`, a drop not yet started
 /// when it is raised is skipped (its outcome "cancelled"; the caller discards the rows)
 /// and every drop run is counted on it.
 pub fn recheck_rows(
@@ -49,7 +50,9 @@ pub fn recheck_rows(
     rows.par_iter_mut().for_each(|row| {
         let mut s = base.clone();
         s.mu_dynamic = row.mu;
-        row.recheck = recheck_with(&s, row, tighter, &run);
+        if let Some(rc) = recheck_with(&s, row, tighter, &run) {
+            rc.apply_to(row);
+        }
     });
 }
 
