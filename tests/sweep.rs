@@ -585,8 +585,8 @@ fn a_resumed_sweep_keeps_the_members_its_probability_ensemble_wrote() {
 }
 
 /// A resumed sweep keeps the critical search and the orbits a killed run finished, and runs
-/// again a critical row that failed drops left undecided. Marked records show which: a kept
-/// file keeps its mark, a rerun one loses it.
+/// again only a critical row that failed drops left undecided. Marked records show which: a
+/// kept file or row keeps its mark, a rerun one loses it.
 #[test]
 fn a_resumed_sweep_keeps_the_finished_critical_search_and_orbits() {
     let dir = temp_dir("resume-extras");
@@ -606,7 +606,8 @@ fn a_resumed_sweep_keeps_the_finished_critical_search_and_orbits() {
     }
     let critical = killed.join("critical.json");
     let text = std::fs::read_to_string(&critical).unwrap();
-    let marked = text.replacen("\"note\": \"", "\"note\": \"KEPT ", 1);
+    let marked = text.replace("\"note\": \"", "\"note\": \"KEPT ");
+    assert_eq!(marked.matches("KEPT").count(), 2, "both rows marked");
     assert_ne!(marked, text);
     std::fs::write(&critical, &marked).unwrap();
     let orbits: Vec<PathBuf> = {
@@ -651,14 +652,23 @@ fn a_resumed_sweep_keeps_the_finished_critical_search_and_orbits() {
         std::fs::read(second).unwrap()
     );
 
-    // A row left undecided by failed drops is run again: the mark goes.
+    // A row left undecided by failed drops is run again (its mark goes); the other row is
+    // kept (its mark stays).
     let undecided = marked.replacen("\"from_rpm\"", "\"undecided\": true,\n    \"from_rpm\"", 1);
     std::fs::write(&critical, &undecided).unwrap();
     resume();
+    let (rows, fresh) = (read_json(&critical), read_json(&full.join("critical.json")));
+    assert_eq!(rows[0], fresh[0], "the undecided row searched again");
+    assert_ne!(rows[1], fresh[1]);
+    let note = rows[1]["note"].as_str().unwrap();
     assert_eq!(
-        std::fs::read(&critical).unwrap(),
-        std::fs::read(full.join("critical.json")).unwrap()
+        note.strip_prefix("KEPT "),
+        fresh[1]["note"].as_str(),
+        "the decided row kept"
     );
+    assert!(std::fs::read_to_string(killed.join("critical.csv"))
+        .unwrap()
+        .contains("KEPT"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -185,9 +185,10 @@ pub fn run_critical_owned(
     run_critical_ticked(spec, out_dir, owns, &Ticker::off(), false)
 }
 
-/// [`run_critical_owned`], counting its drops on `ticker`. With `resume`, a `critical.json`
-/// already in `out_dir` ([`kept_critical`]) is kept and nothing runs; without one, the drops
-/// the killed run logged ([`crate::critical_log`]) are not run again. The log is removed once
+/// [`run_critical_owned`], counting its drops on `ticker`. With `resume`, the decided rows of
+/// a `critical.json` already in `out_dir` ([`kept_critical`]) are kept and only its undecided
+/// rows run again (nothing runs when every row is decided); without one, the drops the killed
+/// run logged ([`crate::critical_log`]) are not run again. The log is removed once
 /// `critical.json` is written.
 fn run_critical_ticked(
     spec: &SweepSpec,
@@ -203,25 +204,45 @@ fn run_critical_ticked(
         .filter(|(j, _)| owns(*j))
         .map(|(_, mu)| mu)
         .collect();
-    if let Some(rows) = resume.then(|| kept_critical(out_dir, &mus)).flatten() {
-        let written = write_critical(out_dir, &rows)?;
+    let kept = resume.then(|| kept_critical(out_dir, &mus)).flatten();
+    // The coefficients to search: all of them, or the kept file's undecided rows.
+    let todo: Vec<f64> = match &kept {
+        Some(rows) => rows.iter().filter(|r| r.undecided).map(|r| r.mu).collect(),
+        None => mus.clone(),
+    };
+    if let (Some(rows), true) = (&kept, todo.is_empty()) {
+        let written = write_critical(out_dir, rows)?;
         // A kill after the last run's critical.json and before its log was removed.
         remove_drop_log(out_dir)?;
         return Ok(written);
     }
-    let rows = if mus.is_empty() {
+    let rows = if todo.is_empty() {
         Vec::new()
     } else {
         let log = DropLog::open(out_dir, resume)?;
         // The spec was validated before anything ran, so this cannot fail.
-        let rows = critical_rows_logged(
+        let mut rows = critical_rows_logged(
             &spec.base_scene(),
-            &mus,
+            &todo,
             &c.options(spec.duration_s),
             ticker,
             Some(&log),
         )
         .expect("the spec's critical section was validated");
+        if let Some(kept) = kept {
+            // The searched rows take the undecided rows' places, in `mus`'s order.
+            let mut searched = rows.into_iter();
+            rows = kept
+                .into_iter()
+                .map(|r| {
+                    if r.undecided {
+                        searched.next().expect("one searched row per undecided row")
+                    } else {
+                        r
+                    }
+                })
+                .collect();
+        }
         let n = log.reused();
         // Through `progress_line`: a closed standard error must not panic the run.
         if n > 0 {
@@ -256,8 +277,8 @@ fn remove_drop_log(out_dir: &Path) -> Result<(), ExtrasError> {
 }
 
 /// The rows of the `critical.json` a killed run of the same spec and build left in `out_dir`,
-/// when it has one row per friction coefficient of `mus`, in that order, and every onset is
-/// decided (a row that failed drops left undecided runs again, as a failed grid point does).
+/// when it has one row per friction coefficient of `mus`, in that order. Its undecided rows
+/// (failed or unsettled drops) are run again by the caller, as a failed grid point is.
 /// `critical.json` is written whole or not at all, so a file that is there is a finished
 /// search.
 fn kept_critical(out_dir: &Path, mus: &[f64]) -> Option<Vec<CriticalRow>> {
@@ -267,7 +288,7 @@ fn kept_critical(out_dir: &Path, mus: &[f64]) -> Option<Vec<CriticalRow>> {
             .iter()
             .zip(mus)
             .all(|(r, mu)| r.mu.to_bits() == mu.to_bits());
-    (same_mus && rows.iter().all(|r| !r.undecided)).then_some(rows)
+    same_mus.then_some(rows)
 }
 
 /// Writes `rows` as `critical.json` and `critical.csv` in `out_dir`; returns the JSON file.
