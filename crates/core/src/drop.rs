@@ -19,6 +19,9 @@ use std::ops::ControlFlow;
 /// Version of the model and its outputs; part of every record key. Bump it when a change
 /// alters results for the same scene.
 ///
+/// - 9: a guard that switched at an event (the located one included) switches once more
+///   when another guard's switch at the same event sent it below zero (a stick that the race's
+///   lift-off puts past its static limit ends at once).
 /// - 8: a guard that crossed together with the located one, or that a mode switch sent
 ///   below zero, takes its own switch (`take_follow_on_jumps` in `ode/hybrid.rs`); a race
 ///   without gravity starts on its support; a contact stepped over, or friction heat below
@@ -43,7 +46,7 @@ use std::ops::ControlFlow;
 ///   classes describe the settled motion on a final window, undecided runs are extended,
 ///   and the whirl rule counts consecutive carried turns ([`crate::classify`]).
 /// - 2: a slip entered against the drifted slip velocity takes its sign.
-pub const MODEL_VERSION: u32 = 8;
+pub const MODEL_VERSION: u32 = 9;
 
 /// Largest first step after a mode switch (s): see [`Stepper::cap_next_step`].
 pub(crate) const STEP_AFTER_SWITCH_S: f64 = 1e-7;

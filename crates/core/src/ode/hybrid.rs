@@ -103,10 +103,14 @@ where
 ///   friction that keeps a contact rolling (eq. 9), jumps. A stick that held its static limit
 ///   (eq. 10) before the lift-off can exceed it after; it kept sticking.
 ///
-/// So after the located jump, in slot order, each at most once and re-evaluated after every
-/// jump, a guard of the new mode takes its own jump when it is at or below zero and crossed
-/// in the step (`crossed`: a crossing, as the driver counts one), or when it is below zero
-/// otherwise. A guard exactly at zero that did not cross is a boundary the jump map itself
+/// So after the located jump, in slot order and re-evaluated after every jump, a guard of the
+/// new mode takes its own jump when it is at or below zero and crossed in the step
+/// (`crossed`: a crossing, as the driver counts one), or when it is below zero otherwise.
+/// Each guard jumps at most once this way, and once more only when it is below zero after
+/// another guard's jump since its own: a located friction switch (slip to stick, within the
+/// static limit) followed by the support's lift-off in the same step can leave the new stick
+/// past its limit, and that stick then ends at once. The bound (two jumps a guard) ends the
+/// loop whatever the jump map does. A guard exactly at zero that did not cross is a boundary the jump map itself
 /// decided: a contact entered with no force yet (an undamped contact starts at `F_n = 0`) sticks
 /// with a friction guard `mu_s F_n - |F_t|` of exactly 0 when no friction is needed; switching it
 /// to a slip there would start a slip whose own guard is 0 and never watched. A guard the
@@ -126,18 +130,30 @@ fn take_follow_on_jumps<S, O, const N: usize>(
     O: HybridObserver<S, N>,
 {
     let all = S::Guard::ALL;
-    let mut done = *violated_before;
-    if let Some(i) = all.iter().position(|g| *g == located) {
-        done[i] = true;
+    // Jumps taken per slot (a violated guard counts as done), and the slot of the last jump.
+    let mut jumps = [0u8; MAX_GUARDS];
+    for (n, &v) in jumps.iter_mut().zip(violated_before) {
+        if v {
+            *n = 2;
+        }
+    }
+    let mut last = all.iter().position(|g| *g == located);
+    if let Some(i) = last {
+        jumps[i] = 1;
     }
     loop {
         let mut g = [0.0; MAX_GUARDS];
         let ng = sys.guards(t, y, &mut g);
-        let Some(j) = (0..ng).find(|&j| !done[j] && (g[j] < 0.0 || (crossed[j] && g[j] <= 0.0)))
-        else {
+        let due = |j: usize| match jumps[j] {
+            0 => g[j] < 0.0 || (crossed[j] && g[j] <= 0.0),
+            1 => g[j] < 0.0 && last != Some(j),
+            _ => false,
+        };
+        let Some(j) = (0..ng).find(|&j| due(j)) else {
             return;
         };
-        done[j] = true;
+        jumps[j] += 1;
+        last = Some(j);
         switch(sys, all[j], t, y, observer);
     }
 }
@@ -167,11 +183,14 @@ mod tests {
 
     /// Two latches over a falling coordinate `y' = -1` from `y = 1`. Latch A opens when its
     /// guard `y - a_at` reaches zero; latch B's guard is `y - b_at`, or `b_after_a` once A is
-    /// open if that is given (a switch that moves another guard).
+    /// open if that is given (a switch that moves another guard). An open A's guard is 1, or
+    /// `a_after_b` once B is open too if that is given; A's jump toggles it (a friction guard
+    /// that ends a stick it began).
     struct Latches {
         a_at: f64,
         b_at: f64,
         b_after_a: Option<f64>,
+        a_after_b: Option<f64>,
         mode: (bool, bool),
     }
 
@@ -192,7 +211,11 @@ mod tests {
         }
         fn guards(&self, _t: f64, y: &[f64; 1], g: &mut [f64; MAX_GUARDS]) -> usize {
             let (a, b) = self.mode;
-            g[0] = if a { y[0] - self.a_at } else { 1.0 };
+            g[0] = match (a, b, self.a_after_b) {
+                (true, _, _) => y[0] - self.a_at,
+                (false, false, Some(after)) => after,
+                (false, _, _) => 1.0,
+            };
             g[1] = match (b, a, self.b_after_a) {
                 (false, _, _) => 1.0,
                 (true, false, Some(after)) => after,
@@ -215,7 +238,7 @@ mod tests {
         }
         fn jump(&self, guard: Latch, _y: &[f64; 1]) -> (bool, bool) {
             match guard {
-                Latch::A => (false, self.mode.1),
+                Latch::A => (!self.mode.0, self.mode.1),
                 Latch::B => (self.mode.0, false),
             }
         }
@@ -223,10 +246,21 @@ mod tests {
 
     /// The mode at t = 1 (y = 0) after starting with both latches closed.
     fn run(a_at: f64, b_at: f64, b_after_a: Option<f64>) -> (bool, bool) {
+        run_toggling(a_at, b_at, b_after_a, None)
+    }
+
+    /// [`run`] with A's guard once both are open.
+    fn run_toggling(
+        a_at: f64,
+        b_at: f64,
+        b_after_a: Option<f64>,
+        a_after_b: Option<f64>,
+    ) -> (bool, bool) {
         let mut sys = Latches {
             a_at,
             b_at,
             b_after_a,
+            a_after_b,
             mode: (true, true),
         };
         let ctl = StepControl {
@@ -270,6 +304,19 @@ mod tests {
         assert_eq!(run(0.5, -1.0, Some(-1.0)), (false, false));
         // Sent exactly to zero without crossing: a boundary the jump decided, left alone.
         assert_eq!(run(0.5, -1.0, Some(0.0)), (false, true));
+    }
+
+    #[test]
+    fn a_located_guard_that_a_follow_on_jump_sends_negative_jumps_again() {
+        // A's crossing is located and B crosses with it; B's jump sends the open A's guard to
+        // -1, so A jumps back (closed). Its guard is then y - 0.5, at zero: it has jumped
+        // twice and is left there.
+        assert_eq!(run_toggling(0.5, 0.5, None, Some(-1.0)), (true, false));
+        // Sent exactly to zero: left alone, as for a first jump.
+        assert_eq!(run_toggling(0.5, 0.5, None, Some(0.0)), (false, false));
+        // B's own crossing later, located: A's jump there is that event's first follow-on
+        // jump, the same outcome.
+        assert_eq!(run_toggling(0.5, 0.25, None, Some(-1.0)), (true, false));
     }
 
     #[test]
