@@ -256,16 +256,18 @@ impl Recheck {
 
     /// Records this re-check in `row`. One the tighter preset does not confirm makes the row
     /// not converged (its onset is the search preset's only) and puts `NOT CONFIRMED` and
-    /// the two drops ([`Recheck::outcomes`]) at the head of its note, so that `critical.csv`,
-    /// which has no re-check columns, says it too.
+    /// the two drops ([`Recheck::outcomes`]) in its note, so that `critical.csv`, which has no
+    /// re-check columns, says it too: at the head of the note, or after the note of an
+    /// undecided row, which starts with `UNDECIDED`.
     pub fn apply_to(self, row: &mut CriticalRow) {
         if !self.confirmed {
             row.converged = false;
-            row.note = format!(
-                "NOT CONFIRMED by the re-check {}; {}",
-                self.outcomes(),
-                row.note
-            );
+            let clause = format!("NOT CONFIRMED by the re-check {}", self.outcomes());
+            row.note = if row.undecided {
+                format!("{}; {clause}", row.note)
+            } else {
+                format!("{clause}; {}", row.note)
+            };
         }
         row.recheck = Some(self);
     }
@@ -279,4 +281,74 @@ pub fn critical_json(rows: &[CriticalRow]) -> String {
 /// Reads `dir/critical.json`, or `None` if it does not exist.
 pub fn read_critical(dir: &Path) -> Result<Option<Vec<CriticalRow>>, ReadError> {
     read_json_optional(&dir.join(CRITICAL_FILE))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(undecided: bool, note: &str) -> CriticalRow {
+        CriticalRow {
+            mu: 0.25,
+            onset_rpm: Some(13375.0),
+            bracket_rpm: Some([13312.5, 13375.0]),
+            class_below: Some(OrbitClass::Pendulum),
+            class_above: Some(OrbitClass::BackwardWhirl),
+            whirl_intervals_rpm: vec![[13375.0, 16000.0]],
+            whirl_at_range_top: true,
+            non_monotone: false,
+            drops: 19,
+            failed_drops: 0,
+            converged: !undecided,
+            undecided,
+            from_rpm: 2000.0,
+            to_rpm: 16000.0,
+            resolution_rpm: 1000.0,
+            tol_rpm: 100.0,
+            duration_s: 1.0,
+            scene_hash: "abc".into(),
+            model_version: 9,
+            note: note.into(),
+            scan: vec![],
+            bisections: vec![],
+            recheck: None,
+        }
+    }
+
+    fn recheck(confirmed: bool) -> Recheck {
+        Recheck {
+            fidelity: Fidelity::Standard,
+            lo: (13312.5, Outcome::Class(OrbitClass::BackwardWhirl)),
+            hi: (13375.0, Outcome::Failed("step_budget: x".into())),
+            confirmed,
+        }
+    }
+
+    #[test]
+    fn an_unconfirmed_re_check_is_in_the_row_and_undecided_stays_first() {
+        let mut r = row(false, "pendulum at 13312.5 r/min");
+        recheck(false).apply_to(&mut r);
+        assert!(!r.converged);
+        assert_eq!(
+            r.note,
+            "NOT CONFIRMED by the re-check at standard: 13312.5 r/min backward_whirl, \
+             13375 r/min failed; pendulum at 13312.5 r/min"
+        );
+        assert!(
+            r.csv_line().contains(",false,false,2000,"),
+            "{}",
+            r.csv_line()
+        );
+
+        let mut u = row(true, "UNDECIDED: 1 drop(s) failed");
+        recheck(false).apply_to(&mut u);
+        assert!(u
+            .note
+            .starts_with("UNDECIDED: 1 drop(s) failed; NOT CONFIRMED"));
+
+        let mut c = row(false, "pendulum at 13312.5 r/min");
+        recheck(true).apply_to(&mut c);
+        assert!(c.converged && c.recheck.is_some());
+        assert_eq!(c.note, "pendulum at 13312.5 r/min");
+    }
 }

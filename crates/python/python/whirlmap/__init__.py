@@ -292,7 +292,9 @@ def critical(
             names the friction coefficients and their failed or unsettled drops. Every row
             is returned.
             Also when, with a ``fidelity`` preset, the re-check at the next tighter preset
-            does not confirm some row's onset bracket (the command line exits 1 then too).
+            does not confirm some row's onset bracket (the command line exits 1 then too);
+            that row's ``converged`` is then false and its ``note`` says ``NOT CONFIRMED by
+            the re-check`` (at its head, or after the ``UNDECIDED`` note of an undecided row).
 
     Raises:
         ValueError: A bad option, friction coefficient or scene parameter (named, with its
