@@ -84,10 +84,11 @@ pub fn run_all(
 /// and the orbit panels at positions `i` for which `owns` is true, and the probability
 /// ensemble when `owns(0)` (it is one job). When more than one fails, the error reported is
 /// the critical search's, then the orbits', then the ensemble's. With `resume` (a sweep's
-/// `--resume` of the same spec and build), what the killed run finished is kept: a
-/// `critical.json` with a decided row for every friction coefficient the run owns (or else the
-/// critical search's logged drops, [`crate::critical_log`]), each orbit file, and the
-/// ensemble's members ([`crate::ensemble::run_ensemble`]); the rest runs.
+/// `--resume` of the same spec and build), what the killed run finished is kept: the decided
+/// rows of a `critical.json` with a row for every friction coefficient the run owns (its
+/// undecided rows are searched again; without that file, the critical search's logged drops
+/// are reused, [`crate::critical_log`]), each orbit file, and the ensemble's members
+/// ([`crate::ensemble::run_ensemble`]); the rest runs.
 pub fn run_all_owned(
     spec: &SweepSpec,
     out_dir: &Path,
