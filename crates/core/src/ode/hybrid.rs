@@ -112,12 +112,14 @@ where
 /// leave the new stick past its limit, and that stick then ends at once. The bound (two jumps
 /// a guard) ends the loop whatever the jump map does. A guard that its own jump leaves below
 /// zero is a jump map that contradicts itself; the drop's has none (each of its jumps enters
-/// a mode whose own guard is at or above zero there: `entering_slip`, `slip_along_drift`). A guard exactly at zero that did not cross is a boundary the jump map itself
-/// decided: a contact entered with no force yet (an undamped contact starts at `F_n = 0`) sticks
-/// with a friction guard `mu_s F_n - |F_t|` of exactly 0 when no friction is needed; switching it
-/// to a slip there would start a slip whose own guard is 0 and never watched. A guard the
-/// first jump made irrelevant (the friction guard once the contact is open) has no slot in the
-/// new mode. A guard that was already violated when the step began (`violated_before`: a
+/// a mode whose own guard is at or above zero there: `entering_slip`, `slip_along_drift`).
+///
+/// A guard exactly at zero that did not cross is a boundary the jump map itself decided: a
+/// contact entered with no force yet (an undamped contact starts at `F_n = 0`) sticks with a
+/// friction guard `mu_s F_n - |F_t|` of exactly 0 when no friction is needed; switching it to
+/// a slip there would start a slip whose own guard is 0 and never watched. A guard the first
+/// jump made irrelevant (the friction guard once the contact is open) has no slot in the new
+/// mode. A guard that was already violated when the step began (`violated_before`: a
 /// crossing stepped over earlier, which the model's own checks report) is left as it was.
 fn take_follow_on_jumps<S, O, const N: usize>(
     sys: &mut S,
