@@ -111,8 +111,12 @@ where
 /// stick, within the static limit) followed by the support's lift-off in the same step can
 /// leave the new stick past its limit, and that stick then ends at once. The bound (two jumps
 /// a guard) ends the loop whatever the jump map does. A guard that its own jump leaves below
-/// zero is a jump map that contradicts itself; the drop's has none (each of its jumps enters
-/// a mode whose own guard is at or above zero there: `entering_slip`, `slip_along_drift`).
+/// zero gets no second jump: the jump map chose that mode. The drop's jumps enter a mode whose
+/// own guard is at or above zero (the contact and support guards change sign; a friction
+/// switch goes through `entering_slip` and `slip_along_drift`), but for one: a slip that ends
+/// (`v_rel = 0`) where eq. 7's raw contact force is already below zero and no friction is
+/// needed enters a stick whose guard `mu_s F_n` is below zero. The contact guard is below zero
+/// there too, and its own follow-on jump opens the contact.
 ///
 /// A guard exactly at zero that did not cross is a boundary the jump map itself decided: a
 /// contact entered with no force yet (an undamped contact starts at `F_n = 0`) sticks with a
@@ -194,13 +198,14 @@ mod tests {
 
     /// Two latches over a falling coordinate `y' = -1` from `y = 1`. Latch A opens when its
     /// guard `y - a_at` reaches zero; latch B's guard is `y - b_at`, or `b_after_a` once A is
-    /// open if that is given (a switch that moves another guard). An open A's guard is 1, or
-    /// `a_after_b` once B is open too if that is given; A's jump toggles it (a friction guard
-    /// that ends a stick it began).
+    /// open if that is given (a switch that moves another guard). An open A's guard is
+    /// `a_open`, or `a_after_b` once B is open too if that is given; A's jump toggles it (a
+    /// friction guard that ends a stick it began).
     struct Latches {
         a_at: f64,
         b_at: f64,
         b_after_a: Option<f64>,
+        a_open: f64,
         a_after_b: Option<f64>,
         mode: (bool, bool),
     }
@@ -225,7 +230,7 @@ mod tests {
             g[0] = match (a, b, self.a_after_b) {
                 (true, _, _) => y[0] - self.a_at,
                 (false, false, Some(after)) => after,
-                (false, _, _) => 1.0,
+                (false, _, _) => self.a_open,
             };
             g[1] = match (b, a, self.b_after_a) {
                 (false, _, _) => 1.0,
@@ -257,20 +262,22 @@ mod tests {
 
     /// The mode at t = 1 (y = 0) after starting with both latches closed.
     fn run(a_at: f64, b_at: f64, b_after_a: Option<f64>) -> (bool, bool) {
-        run_toggling(a_at, b_at, b_after_a, None)
+        run_toggling(a_at, b_at, b_after_a, 1.0, None)
     }
 
-    /// [`run`] with A's guard once both are open.
+    /// [`run`] with an open A's guard, alone and once B is open too.
     fn run_toggling(
         a_at: f64,
         b_at: f64,
         b_after_a: Option<f64>,
+        a_open: f64,
         a_after_b: Option<f64>,
     ) -> (bool, bool) {
         let mut sys = Latches {
             a_at,
             b_at,
             b_after_a,
+            a_open,
             a_after_b,
             mode: (true, true),
         };
@@ -322,9 +329,19 @@ mod tests {
         // A's crossing is located and B crosses with it; B's jump sends the open A's guard to
         // -1, so A jumps back (closed). Its guard is then y - 0.5, at zero: it has jumped
         // twice and is left there.
-        assert_eq!(run_toggling(0.5, 0.5, None, Some(-1.0)), (true, false));
+        assert_eq!(run_toggling(0.5, 0.5, None, 1.0, Some(-1.0)), (true, false));
         // Sent exactly to zero: left alone, as for a first jump.
-        assert_eq!(run_toggling(0.5, 0.5, None, Some(0.0)), (false, false));
+        assert_eq!(run_toggling(0.5, 0.5, None, 1.0, Some(0.0)), (false, false));
+    }
+
+    #[test]
+    fn a_guard_its_own_jump_left_below_zero_does_not_jump_again() {
+        // A's own jump leaves its guard at -1 (the jump map chose that mode); B's jump at the
+        // same event keeps it there. B's jump did not send it below zero: no second jump.
+        assert_eq!(
+            run_toggling(0.5, 0.5, None, -1.0, Some(-1.0)),
+            (false, false)
+        );
     }
 
     #[test]

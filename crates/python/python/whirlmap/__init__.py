@@ -294,7 +294,8 @@ def critical(
             Also when, with a ``fidelity`` preset, the re-check at the next tighter preset
             does not confirm some row's onset bracket (the command line exits 1 then too);
             that row's ``converged`` is then false and its ``note`` says ``NOT CONFIRMED by
-            the re-check`` (at its head, or after the ``UNDECIDED`` note of an undecided row).
+            the re-check`` (at its head, or at the end of an undecided row's note, which
+            starts with ``UNDECIDED``).
 
     Raises:
         ValueError: A bad option, friction coefficient or scene parameter (named, with its
