@@ -27,9 +27,20 @@ impl Palmgren {
     /// and no integrator step straddles a jump. Differences stay below 0.8 % in that band.
     #[inline]
     pub fn viscous_torque_n_m(&self, omega_rad_s: f64) -> f64 {
+        self.viscous_from_x23(self.nu0_n_pow_2_3(omega_rad_s))
+    }
+
+    /// `(nu0 n)^(2/3)` of eq. 12 at race speed `omega_rad_s`.
+    #[inline]
+    fn nu0_n_pow_2_3(&self, omega_rad_s: f64) -> f64 {
         let x = self.nu0_mm2_s * omega_rad_s.abs() * RAD_S_TO_RPM;
         // powf rather than cbrt: Rust's cbrt is a slow software routine (see hertz.rs).
-        let x23 = x.powf(2.0 / 3.0);
+        x.powf(2.0 / 3.0)
+    }
+
+    /// M_0 (N m) of eq. 12 from `(nu0 n)^(2/3)`.
+    #[inline]
+    fn viscous_from_x23(&self, x23: f64) -> f64 {
         1e-7 * self.f0 * x23.max(160.0) * self.dm_mm.powi(3) * 1e-3
     }
 
@@ -46,22 +57,25 @@ impl Palmgren {
         f1 * p * self.dm_mm * 1e-3
     }
 
-    /// The slopes of [`Palmgren::torque_n_m`]: `(dM/d omega` (N m s), `dM/d load` (m)`)`.
-    /// Eq. 12's M_0 grows as `|omega|^(2/3)` above its low-speed constant (flat below it);
-    /// eq. 13's M_1 as `load^1.33`.
-    pub fn torque_slopes(&self, omega_rad_s: f64, load_n: f64) -> (f64, f64) {
-        let x = self.nu0_mm2_s * omega_rad_s.abs() * RAD_S_TO_RPM;
-        let d_omega = if omega_rad_s != 0.0 && x.powf(2.0 / 3.0) > 160.0 {
-            (2.0 / 3.0) * self.viscous_torque_n_m(omega_rad_s) / omega_rad_s
+    /// The torque of [`Palmgren::torque_n_m`] and its slopes: `(M` (N m), `dM/d omega`
+    /// (N m s), `dM/d load` (m)`)`. Eq. 12's M_0 grows as `|omega|^(2/3)` above its
+    /// low-speed constant (flat below it); eq. 13's M_1 as `load^1.33`. Each power is taken
+    /// once: the torque has the bits of [`Palmgren::torque_n_m`].
+    pub fn torque_and_slopes(&self, omega_rad_s: f64, load_n: f64) -> (f64, f64, f64) {
+        let x23 = self.nu0_n_pow_2_3(omega_rad_s);
+        let m0 = self.viscous_from_x23(x23);
+        let m1 = self.load_torque_n_m(load_n);
+        let d_omega = if omega_rad_s != 0.0 && x23 > 160.0 {
+            (2.0 / 3.0) * m0 / omega_rad_s
         } else {
             0.0
         };
         let d_load = if load_n > 0.0 {
-            1.33 * self.load_torque_n_m(load_n) / load_n
+            1.33 * m1 / load_n
         } else {
             0.0
         };
-        (d_omega, d_load)
+        (m0 + m1, d_omega, d_load)
     }
 
     /// Total drag torque magnitude M = M_0 + M_1 (N m), eq. 11.
@@ -118,7 +132,8 @@ mod tests {
         // Above eq. 12's low-speed constant, either sign of the speed; below it (flat).
         for omega in [-900.0, -50.0, 30.0, 400.0, 3000.0, 0.5] {
             for load in [0.0, 3.0, 500.0, 20_000.0] {
-                let (dw, dl) = b.torque_slopes(omega, load);
+                let (m, dw, dl) = b.torque_and_slopes(omega, load);
+                assert_eq!(m.to_bits(), b.torque_n_m(omega, load).to_bits());
                 let h = 1e-6 * f64::abs(omega);
                 let fd_w =
                     (b.torque_n_m(omega + h, load) - b.torque_n_m(omega - h, load)) / (2.0 * h);

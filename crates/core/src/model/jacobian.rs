@@ -300,10 +300,10 @@ impl DropSystem {
         let p = self.drag.as_ref()?;
         let wb = y[ix::WB];
         let load = f.support_n + self.thermal_load_n;
-        let (dm_dw, dm_dload) = p.torque_slopes(wb, load);
+        let (m, dm_dw, dm_dload) = p.torque_and_slopes(wb, load);
         let (dir, ddir) = drag::direction_and_slope(wb, self.omega_eps);
         Some(DragSlopes {
-            m: p.torque_n_m(wb, load),
+            m,
             dm_dw,
             dm_dload,
             dir,
