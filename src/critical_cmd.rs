@@ -187,15 +187,22 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
             .map_err(|e| Failure::Output(anyhow::anyhow!("cannot write {}: {e}", p.display())))?;
     }
     let undecided = report_undecided(&rows);
-    let unconfirmed = whirlmap_sweep::critical::unconfirmed_summary(&rows);
-    if let Some(list) = &unconfirmed {
-        errln!(
-            "error: the re-check at the next tighter preset does not confirm the onset at \
-             {list}; the onset at this preset is not to be trusted there: search those \
-             coefficients at the tighter preset"
-        );
-    }
-    Ok(Done::flagged_if(undecided || unconfirmed.is_some()))
+    let unconfirmed = report_unconfirmed(&rows);
+    Ok(Done::flagged_if(undecided || unconfirmed))
+}
+
+/// Says on standard error which rows' onsets the re-check at the next tighter preset did
+/// not confirm (the `sweep` command shares it); true when there are some.
+pub(crate) fn report_unconfirmed(rows: &[CriticalRow]) -> bool {
+    let Some(list) = whirlmap_sweep::critical::unconfirmed_summary(rows) else {
+        return false;
+    };
+    errln!(
+        "error: the re-check at the next tighter preset does not confirm the onset at \
+         {list}; the onset at this preset is not to be trusted there: search those \
+         coefficients at the tighter preset"
+    );
+    true
 }
 
 /// Says on standard error which rows failed drops left undecided (see

@@ -1,12 +1,14 @@
 //! `whirlmap sweep FILE`: run a grid of drops from a JSON sweep spec.
 //!
 //! Exit codes: 0 every point ok; 1 some point or orbit drop failed, or failed drops left a
-//! critical speed undecided (records and every critical row still written); 2 bad spec, an
+//! critical speed undecided, or the `critical.recheck` at a tighter preset did not confirm
+//! an onset (records and every critical row still written); 2 bad spec, an
 //! unusable output folder, or one that is in use or holds another run's results (nothing
 //! run); 4 an output (records or charts) could not be written, a full disk included.
 
 use crate::{CmdResult, Done, Failure};
 use std::path::{Path, PathBuf};
+use whirlmap_sweep::critical::CriticalRow;
 use whirlmap_sweep::pipeline::{self, ChartsFailed, Stages};
 use whirlmap_sweep::spec;
 use whirlmap_sweep::sweep::{ProgressMode, RunOptions, SweepOutcome};
@@ -68,35 +70,55 @@ pub(crate) fn counts(outcome: &SweepOutcome) -> String {
 }
 
 /// Prints the summary line of the critical speeds in `dir` (`critical.json` at `path`),
-/// with how many rows failed drops left undecided, and says which on standard error (as
-/// `whirlmap critical` does). True when some row is undecided. The sweep, shard and merge
-/// commands share it.
+/// with how many rows failed drops left undecided and how many the re-check at a tighter
+/// preset did not confirm, and says which on standard error (as `whirlmap critical` does).
+/// True when some row is undecided or not confirmed. The sweep, shard and merge commands
+/// share it.
 pub(crate) fn critical_line(dir: &Path, path: &Path) -> bool {
     let rows = whirlmap_sweep::results::critical::read_critical(dir)
         .ok()
         .flatten()
         .unwrap_or_default();
-    let undecided: Vec<String> = rows
-        .iter()
-        .filter(|r| r.undecided)
-        .map(|r| format!("mu {}", r.mu))
-        .collect();
-    if undecided.is_empty() {
+    let list = |pick: &dyn Fn(&CriticalRow) -> bool| -> Vec<String> {
+        (rows.iter().filter(|r| pick(r)))
+            .map(|r| format!("mu {}", r.mu))
+            .collect()
+    };
+    let undecided = list(&|r| r.undecided);
+    let unconfirmed = list(&|r| r.recheck.as_ref().is_some_and(|rc| !rc.confirmed));
+    let mut parts = Vec::new();
+    if !undecided.is_empty() {
+        parts.push(format!(
+            "{} of {} undecided by failed or unsettled drops: {}",
+            undecided.len(),
+            rows.len(),
+            undecided.join(", ")
+        ));
+    }
+    if !unconfirmed.is_empty() {
+        parts.push(format!(
+            "{} of {} not confirmed by the re-check: {}",
+            unconfirmed.len(),
+            rows.len(),
+            unconfirmed.join(", ")
+        ));
+    }
+    if parts.is_empty() {
         outln!("  critical speeds  {}", path.display());
         return false;
     }
     outln!(
-        "  critical speeds  {} ({} of {} undecided by failed or unsettled drops: {})",
+        "  critical speeds  {} ({})",
         path.display(),
-        undecided.len(),
-        rows.len(),
-        undecided.join(", ")
+        parts.join("; ")
     );
-    crate::critical_cmd::report_undecided(&rows)
+    let undecided = crate::critical_cmd::report_undecided(&rows);
+    let unconfirmed = crate::critical_cmd::report_unconfirmed(&rows);
+    undecided || unconfirmed
 }
 
-/// Runs the subcommand: `Flagged` (exit 1) when some points failed or failed drops left a
-/// critical speed undecided.
+/// Runs the subcommand: `Flagged` (exit 1) when some points failed, failed drops left a
+/// critical speed undecided or the re-check did not confirm an onset.
 pub fn run(a: &SweepArgs) -> CmdResult {
     let spec = spec::read(&a.file).map_err(|e| Failure::coded(2, e))?;
     if let (Some(i), Some(n)) = (a.shard, a.shards) {

@@ -94,6 +94,16 @@ fn bad_specs_exit_2_name_the_field_and_run_nothing() {
             &["grid point 1", "clearance_m = -0.001"],
         ),
         (
+            "a critical re-check without a fidelity preset",
+            format!("{{{base}, \"critical\": {{\"mu\": [0.3], \"speed_rpm\": {{\"from\": 1000, \"to\": 2000}}, \"recheck\": true}}}}"),
+            &["critical.recheck = true without a fidelity", "draft or standard"],
+        ),
+        (
+            "a critical re-check at the tightest preset",
+            format!("{{{base}, \"fidelity\": \"reference\", \"critical\": {{\"mu\": [0.3], \"speed_rpm\": {{\"from\": 1000, \"to\": 2000}}, \"recheck\": true}}}}"),
+            &["critical.recheck = true with fidelity reference"],
+        ),
+        (
             "a grid speed at or below the stop speed",
             r#"{"name": "bad", "duration_s": 0.05, "scene": {"stop_speed_rpm": 5000},
                 "axes": {"speed_rpm": [8000, 4000]}}"#
@@ -669,6 +679,89 @@ fn a_resumed_sweep_keeps_the_finished_critical_search_and_orbits() {
     assert!(std::fs::read_to_string(killed.join("critical.csv"))
         .unwrap()
         .contains("KEPT"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// With `critical.recheck`, a sweep re-checks each onset bracket at the next tighter preset
+/// as `whirlmap critical --fidelity` does: its rows are the command's, a bracket the tighter
+/// preset does not confirm (mu 0.25 at `draft`, see tests/critical.rs) leaves its row not
+/// converged, the summary and standard error name it, and the sweep exits 1.
+#[test]
+fn a_sweep_rechecks_its_critical_brackets_when_asked() {
+    let dir = temp_dir("recheck");
+    let spec = spec_file(
+        &dir,
+        "rc.json",
+        r#"{"name": "rc", "duration_s": 1.0, "fidelity": "draft",
+            "axes": {"speed_rpm": [4000], "mu": [0.3]},
+            "critical": {"mu": [0.25, 0.35], "speed_rpm": {"from": 2000, "to": 16000},
+              "resolution_rpm": 1000, "tol_rpm": 100, "recheck": true},
+            "charts": ["critical"]}"#,
+    );
+    let out_dir = dir.join("out");
+    let o = whirlmap(&["sweep", s(&spec), "--out", s(&out_dir), "--no-progress"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        out(&o).contains("1 of 2 not confirmed by the re-check: mu 0.25"),
+        "{}",
+        out(&o)
+    );
+    assert!(
+        stderr(&o).contains("does not confirm the onset at mu 0.25 (at standard:"),
+        "{}",
+        stderr(&o)
+    );
+    let rows = read_json(&out_dir.join("critical.json"));
+    assert_eq!(rows[0]["recheck"]["confirmed"], false, "{rows}");
+    assert_eq!(rows[0]["converged"], false, "{rows}");
+    assert_eq!(rows[1]["recheck"]["confirmed"], true, "{rows}");
+    assert_eq!(rows[1]["recheck"]["fidelity"], "standard", "{rows}");
+    assert!(std::fs::read_to_string(out_dir.join("critical.csv"))
+        .unwrap()
+        .contains("NOT CONFIRMED by the re-check at standard"));
+    let cli = whirlmap(&[
+        "critical",
+        "--json",
+        "--mu",
+        "0.25",
+        "--mu",
+        "0.35",
+        "--from",
+        "2000",
+        "--to",
+        "16000",
+        "--resolution-rpm",
+        "1000",
+        "--tol-rpm",
+        "100",
+        "--fidelity",
+        "draft",
+        "--no-progress",
+    ]);
+    let cli: serde_json::Value = serde_json::from_slice(&cli.stdout).expect("the rows");
+    assert_eq!(rows, cli, "the sweep's rows are the command's");
+
+    // Without `recheck` the same search has no re-check and exits 0.
+    let plain = spec_file(
+        &dir,
+        "plain.json",
+        &std::fs::read_to_string(&spec)
+            .unwrap()
+            .replace(r#", "recheck": true"#, ""),
+    );
+    let o = whirlmap(&[
+        "sweep",
+        s(&plain),
+        "--out",
+        s(&dir.join("plain")),
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let rows = read_json(&dir.join("plain").join("critical.json"));
+    assert!(
+        rows[0].get("recheck").is_none() && rows[0]["converged"] == true,
+        "{rows}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -7,7 +7,8 @@
 //!   between neighbouring coefficients that both whirl in the range); an onset found already
 //!   at the lowest scanned speed carries a downward arrow (at or below it); an onset that
 //!   failed or unsettled drops leave undecided (`undecided` in `critical.json`) is an open circle, joined
-//!   to no neighbour;
+//!   to no neighbour; an onset the re-check at a tighter preset did not confirm (`recheck` in
+//!   `critical.json`, not `confirmed`) is an open square, joined to no neighbour;
 //! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
 //!   to the top of the searched range;
 //! - **no whirl in range** as an open triangle at the range top;
@@ -28,7 +29,7 @@ use whirlmap_results::critical::CriticalRow;
 use whirlmap_results::grid::clamp_value;
 
 use crate::axes::MU_DESC;
-use crate::marks::{arrow, legend, triangle_up, Mark, BAND};
+use crate::marks::{arrow, legend, open_square, triangle_up, Mark, BAND};
 use crate::render::{
     draw_mesh, format_quantity, text_style, with_header, DrawResult, Figure, TITLE_BAND,
     TITLE_FONT, X_LABEL_AREA, Y_LABEL_AREA,
@@ -217,10 +218,22 @@ impl Figure for Fig4<'_> {
         }
         let mut any_below = false;
         let mut any_undecided = false;
+        // The presets whose re-check did not confirm an onset, for the legend.
+        let mut unconfirmed_at: Vec<&str> = Vec::new();
         for (r, o) in rows.iter().zip(&onsets) {
             let Some((mu, s)) = o else { continue };
             let p = px(*mu, *s);
-            if r.undecided {
+            if let Some(rc) = r
+                .recheck
+                .as_ref()
+                .filter(|rc| !rc.confirmed && !r.undecided)
+            {
+                // The tighter preset disagrees: an open square.
+                if !unconfirmed_at.contains(&rc.fidelity.name()) {
+                    unconfirmed_at.push(rc.fidelity.name());
+                }
+                open_square(&canvas, p, 6, BAND)?;
+            } else if r.undecided {
                 // Failed drops could move this onset: an open circle.
                 any_undecided = true;
                 canvas.draw(&Circle::new(p, 6, WHITE.filled()))?;
@@ -254,13 +267,29 @@ impl Figure for Fig4<'_> {
                 4,
                 NONE_MARK.mix(0.6).stroke_width(1),
             ))?;
-            canvas.draw_text(
-                &format!("top of the searched range, {} r/min", format_quantity(t)),
-                &text_style(13.0)
-                    .color(&NONE_MARK)
-                    .pos(Pos::new(HPos::Left, VPos::Bottom)),
-                (a.0 + 6, a.1 - 12),
-            )?;
+            let label = format!("top of the searched range, {} r/min", format_quantity(t));
+            let style = text_style(13.0)
+                .color(&NONE_MARK)
+                .pos(Pos::new(HPos::Left, VPos::Bottom));
+            // At the left edge, or in the widest gap between the columns' marks when it is
+            // there that the label fits (an arrow or a triangle at the first column's top
+            // would cross it at the edge).
+            let width = canvas.estimate_text_size(&label, &style)?.0 as i32;
+            let mut edges: Vec<i32> = rows.iter().map(|r| px(r.mu, t).0).collect();
+            edges.push(b.0);
+            let gap = edges
+                .iter()
+                .scan(a.0, |left, &right| {
+                    let g = (*left, right);
+                    *left = right;
+                    Some(g)
+                })
+                .max_by_key(|(l, r)| r - l);
+            let x = match gap {
+                Some((l, r)) if r - l >= width + 40 => (l + r - width) / 2,
+                _ => a.0 + 6,
+            };
+            canvas.draw_text(&label, &style, (x, a.1 - 12))?;
         }
 
         let mut entries = vec![
@@ -288,6 +317,15 @@ impl Figure for Fig4<'_> {
                 "onset undecided: failed or unsettled drops could move it".to_string(),
             ));
         }
+        if !unconfirmed_at.is_empty() {
+            entries.push((
+                Mark::OpenSquare(BAND),
+                format!(
+                    "onset not confirmed by the re-check at {}",
+                    unconfirmed_at.join(", ")
+                ),
+            ));
+        }
         if any_none {
             entries.push((Mark::TriangleUp(NONE_MARK), "no whirl in range".to_string()));
         }
@@ -308,9 +346,12 @@ impl Figure for Fig4<'_> {
 }
 
 /// Whether the onset curve joins two neighbouring rows: both whirl in the range and neither
-/// onset is undecided.
+/// onset is undecided or left unconfirmed by a re-check.
 fn joined(a: &CriticalRow, b: &CriticalRow) -> bool {
-    a.onset_rpm.is_some() && b.onset_rpm.is_some() && !a.undecided && !b.undecided
+    let sure = |r: &CriticalRow| {
+        r.onset_rpm.is_some() && !r.undecided && r.recheck.as_ref().is_none_or(|rc| rc.confirmed)
+    };
+    sure(a) && sure(b)
 }
 
 /// Converts an RGBA colour back to RGB (for swatches of mixed colours).
@@ -396,6 +437,73 @@ mod tests {
         let mut decided = rows.clone();
         decided[i].undecided = false;
         assert_ne!(pixels(&rows), pixels(&decided));
+    }
+
+    /// An onset the re-check at a tighter preset did not confirm is joined to no neighbour and
+    /// drawn apart from both a decided and an undecided one (an open square); a confirmed
+    /// re-check changes nothing.
+    #[test]
+    fn an_unconfirmed_onset_is_not_joined_and_is_drawn_apart() {
+        use whirlmap_core::classify::OrbitClass;
+        use whirlmap_core::Fidelity;
+        use whirlmap_results::critical::{Outcome, Recheck};
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/paper");
+        let mut rows = whirlmap_results::critical::read_critical(&dir)
+            .expect("committed critical.json")
+            .expect("a critical search");
+        rows.sort_by(|a, b| a.mu.total_cmp(&b.mu));
+        let i = rows
+            .iter()
+            .position(|r| (r.mu - 0.4).abs() < 1e-9)
+            .expect("mu 0.4");
+        let [lo, hi] = rows[i].bracket_rpm.expect("a bracket");
+        let recheck = |confirmed: bool| Recheck {
+            fidelity: Fidelity::Reference,
+            lo: (lo, Outcome::Class(OrbitClass::BackwardWhirl)),
+            hi: (hi, Outcome::Class(OrbitClass::BackwardWhirl)),
+            confirmed,
+        };
+        let draw = |rows: &[CriticalRow], tag: &str| {
+            let path = std::env::temp_dir().join(format!(
+                "whirlmap-fig4-recheck-{}-{tag}.png",
+                std::process::id()
+            ));
+            let fig = Fig4 {
+                rows,
+                band: None,
+                title: "Fig. 4 with an unconfirmed onset".into(),
+            };
+            crate::render::render(&path, (1000, 700), &fig).unwrap();
+            let bytes = std::fs::read(&path).unwrap();
+            if std::env::var_os("WHIRLMAP_KEEP_CHART").is_some() {
+                eprintln!("chart: {}", path.display());
+            } else {
+                std::fs::remove_file(&path).ok();
+            }
+            bytes
+        };
+        let plain = draw(&rows, "plain");
+        let mut confirmed = rows.clone();
+        recheck(true).apply_to(&mut confirmed[i]);
+        assert!(
+            joined(&confirmed[i - 1], &confirmed[i]) && joined(&confirmed[i], &confirmed[i + 1])
+        );
+        assert_eq!(
+            draw(&confirmed, "confirmed"),
+            plain,
+            "a confirmed onset is drawn as before"
+        );
+
+        let mut unconfirmed = rows.clone();
+        recheck(false).apply_to(&mut unconfirmed[i]);
+        let u = &unconfirmed;
+        assert!(!joined(&u[i - 1], &u[i]) && !joined(&u[i], &u[i + 1]));
+        assert!(joined(&u[i + 1], &u[i + 2]), "the others stay joined");
+        let mut undecided = rows.clone();
+        undecided[i].undecided = true;
+        let drawn = draw(&unconfirmed, "unconfirmed");
+        assert_ne!(drawn, plain);
+        assert_ne!(drawn, draw(&undecided, "undecided"));
     }
 
     #[test]

@@ -72,6 +72,8 @@ pub enum Mark {
     ArrowDown(RGBColor),
     /// An open circle.
     OpenDot(RGBColor),
+    /// An open square ([`open_square`]).
+    OpenSquare(RGBColor),
     /// Where a drop was, on a grid of uneven cells ([`drop_dot`]).
     Drop,
 }
@@ -272,6 +274,7 @@ pub(crate) fn draw_mark<DB: DrawingBackend>(
             area.draw(&Circle::new((x + mark_w / 2, y), 5, WHITE.filled()))?;
             area.draw(&Circle::new((x + mark_w / 2, y), 5, c.stroke_width(2)))?;
         }
+        Mark::OpenSquare(c) => open_square(area, (x + mark_w / 2, y), 5, c)?,
         Mark::Fill(c) => {
             area.draw(&Rectangle::new(
                 [(bx0, by0), (bx1, by1)],
@@ -281,6 +284,18 @@ pub(crate) fn draw_mark<DB: DrawingBackend>(
         }
     }
     Ok(())
+}
+
+/// An open square of half-width `r` centred at pixel `p`: white inside, a 2 px outline.
+pub(crate) fn open_square<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x, y): (i32, i32),
+    r: i32,
+    colour: RGBColor,
+) -> DrawResult<DB> {
+    let corners = [(x - r, y - r), (x + r, y + r)];
+    area.draw(&Rectangle::new(corners, WHITE.filled()))?;
+    area.draw(&Rectangle::new(corners, colour.stroke_width(2)))
 }
 
 /// Draws `text` with a white box behind it, centred at pixel `(x, y)` of `area`.

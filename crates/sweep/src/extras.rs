@@ -9,7 +9,7 @@ use crate::spec::SweepSpec;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
-use whirlmap_core::DropOptions;
+use whirlmap_core::{DropOptions, Fidelity};
 use whirlmap_results::critical::critical_json;
 use whirlmap_results::files::{orbit_error_file, orbit_file, ORBITS_DIR};
 use whirlmap_results::orbit::OrbitFile;
@@ -186,7 +186,9 @@ pub fn run_critical_owned(
     run_critical_ticked(spec, out_dir, owns, &Ticker::off(), false)
 }
 
-/// [`run_critical_owned`], counting its drops on `ticker`. With `resume`, the decided rows of
+/// [`run_critical_owned`], counting its drops on `ticker`. With `critical.recheck`, each
+/// searched row's bracket is re-checked at the next tighter preset ([`crate::recheck`]).
+/// With `resume`, the decided rows of
 /// a `critical.json` already in `out_dir` ([`kept_critical`]) are kept and only its undecided
 /// rows run again (nothing runs when every row is decided); without one, the drops the killed
 /// run logged ([`crate::critical_log`]) are not run again. The log is removed once
@@ -230,6 +232,17 @@ fn run_critical_ticked(
             Some(&log),
         )
         .expect("the spec's critical section was validated");
+        if let Some(tighter) = spec
+            .fidelity
+            .and_then(Fidelity::tighter)
+            .filter(|_| c.recheck)
+        {
+            let opts = DropOptions {
+                duration_s: spec.duration_s,
+                ..Default::default()
+            };
+            crate::recheck::recheck_rows(&spec.base_scene(), &mut rows, tighter, &opts, None);
+        }
         if let Some(kept) = kept {
             // The searched rows take the undecided rows' places, in `mus`'s order.
             let mut searched = rows.into_iter();

@@ -222,6 +222,12 @@ pub struct CriticalSpec {
     /// Bisection tolerance (r/min), [0.01, `resolution_rpm`]. Default 25.
     #[serde(default = "default_tol_rpm")]
     pub tol_rpm: f64,
+    /// Re-check each onset bracket at the next tighter preset than the sweep's `fidelity`
+    /// (which must be `draft` or `standard`), as `whirlmap critical --fidelity` does: the row
+    /// records it as `recheck`, and a bracket the tighter preset does not confirm leaves it
+    /// not converged ([`crate::recheck`]). Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub recheck: bool,
 }
 
 impl CriticalSpec {
@@ -747,6 +753,18 @@ impl SweepSpec {
                     value: e.value,
                     allowed: e.allowed,
                 })?;
+            }
+            if c.recheck && self.fidelity.and_then(Fidelity::tighter).is_none() {
+                return Err(SpecError::Invalid {
+                    field: "critical.recheck".into(),
+                    value: match self.fidelity {
+                        Some(f) => format!("true with fidelity {}", f.name()),
+                        None => "true without a fidelity".into(),
+                    },
+                    allowed: "true only with `fidelity` draft or standard (the re-check runs at \
+                              the next tighter preset), or false"
+                        .into(),
+                });
             }
             crate::critical::check_range(
                 c.speed_rpm.from,
