@@ -199,8 +199,9 @@ pub(crate) fn report_unconfirmed(rows: &[CriticalRow]) -> bool {
     };
     errln!(
         "error: the re-check at the next tighter preset does not confirm the onset at \
-         {list}; the onset at this preset is not to be trusted there: search those \
-         coefficients at the tighter preset"
+         {list}; the onset at this preset is not to be trusted there: where the tighter \
+         preset puts it, searched at least two lattice steps either side of the bracket, is in the \
+         row"
     );
     true
 }
@@ -311,10 +312,24 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                     "NOT confirmed"
                 }
             );
+            if let Some(w) = &rc.relocated {
+                outln!(
+                    "    searched again      {}-{} r/min at {}: {} ({} drops)",
+                    fmt_rpm(w.window_rpm[0]),
+                    fmt_rpm(w.window_rpm[1]),
+                    rc.fidelity,
+                    w.note,
+                    w.drops
+                );
+            }
         }
     }
     let drops: usize = rows.iter().map(|r| r.drops).sum::<usize>()
-        + 2 * rows.iter().filter(|r| r.recheck.is_some()).count();
+        + rows
+            .iter()
+            .filter_map(|r| r.recheck.as_ref())
+            .map(|rc| rc.drops())
+            .sum::<usize>();
     outln!();
     outln!("  {drops} drops, {wall_s:.2} s wall");
 }

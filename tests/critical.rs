@@ -364,7 +364,9 @@ fn failed_drops_that_leave_the_onset_undecided_exit_1_with_every_row_written() {
 /// A `draft` search whose onset the re-check at `standard` does not confirm (standard whirls
 /// on both sides of the draft bracket, near the paper's onset of about 11 500 r/min at
 /// mu 0.25): every row printed, and exit 1 with the coefficient and what the re-check found.
-/// A confirmed re-check exits 0.
+/// The onset the re-check then finds near the bracket is the one a search at `standard` over
+/// the whole range finds (the lattice is the same, and a search does not depend on its
+/// range). A confirmed re-check exits 0.
 #[test]
 fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
     let args = [
@@ -401,6 +403,34 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
             && err.contains("backward_whirl"),
         "{err}"
     );
+    // Where `standard` puts the onset: searched two lattice steps either side of the
+    // bracket, and the same as a `standard` search of the whole range finds.
+    let relocated = &rows[0]["recheck"]["relocated"];
+    let [lo, hi] = [0, 1].map(|i| rows[0]["bracket_rpm"][i].as_f64().unwrap());
+    // From two lattice steps below the lattice point under the bracket to two above the one
+    // over it (here the range top).
+    assert!(lo > 13000.0 && hi <= 14000.0, "{lo} {hi}");
+    assert_eq!(
+        relocated["window_rpm"],
+        serde_json::json!([11000.0, 16000.0])
+    );
+    let mut standard = args.to_vec();
+    standard.truncate(args.len() - 3); // no `--fidelity draft`: the scene's numerics
+    standard.push("--no-progress");
+    let o = whirlmap(&standard);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let full: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
+    let onset = full[0]["onset_rpm"].as_f64().expect("an onset at standard");
+    assert_eq!(relocated["onset_rpm"].as_f64(), Some(onset), "{rows}");
+    assert!(
+        onset < lo,
+        "standard's onset {onset} lies below the draft bracket"
+    );
+    assert!(
+        note.contains(&format!("its onset there {onset} r/min"))
+            || note.contains(&format!("its onset there {onset:.1} r/min")),
+        "{note}"
+    );
     // mu 0.35, whose onset near 5 000 r/min both presets find: confirmed, exit 0.
     let mut ok = args.to_vec();
     ok[3] = "0.35";
@@ -408,6 +438,7 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
     assert_eq!(o.status.code(), Some(0), "{}", out(&o));
     let rows: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
     assert_eq!(rows[0]["recheck"]["confirmed"], true, "{rows}");
+    assert!(rows[0]["recheck"].get("relocated").is_none(), "{rows}");
     assert_eq!(rows[0]["converged"], true, "{rows}");
     assert!(
         !rows[0]["note"]

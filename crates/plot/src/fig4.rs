@@ -462,6 +462,7 @@ mod tests {
             lo: (lo, Outcome::Class(OrbitClass::BackwardWhirl)),
             hi: (hi, Outcome::Class(OrbitClass::BackwardWhirl)),
             confirmed,
+            relocated: None,
         };
         let draw = |rows: &[CriticalRow], tag: &str| {
             let path = std::env::temp_dir().join(format!(

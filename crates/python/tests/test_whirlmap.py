@@ -220,6 +220,14 @@ def test_critical_warns_when_the_re_check_does_not_confirm_the_onset() -> None:
     assert rows[0]["recheck"]["confirmed"] is False
     assert rows[0]["converged"] is False
     assert rows[0]["note"].startswith("NOT CONFIRMED by the re-check at standard: ")
+    # Where standard puts the onset: the search of a standard preset over the same range,
+    # run here whole, finds the same.
+    relocated = rows[0]["recheck"]["relocated"]
+    whole = whirlmap.critical(
+        0.25, from_rpm=2000, to_rpm=16000, resolution_rpm=1000, tol_rpm=100,
+    )  # fmt: skip
+    assert relocated["onset_rpm"] == whole[0]["onset_rpm"] < rows[0]["bracket_rpm"][0]
+    assert relocated["note"] in rows[0]["note"]
 
 
 def test_critical_checks_before_running() -> None:

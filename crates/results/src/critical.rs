@@ -234,24 +234,55 @@ pub struct Recheck {
     pub hi: (f64, Outcome),
     /// True when the tighter preset also gives no whirl at `lo` and whirl at `hi`.
     pub confirmed: bool,
+    /// Where the tighter preset puts the onset, when it does not confirm the bracket.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relocated: Option<Relocated>,
+}
+
+/// The search run again at the re-check's tighter preset when that preset does not confirm
+/// the bracket, on the search's lattice and tolerance, from two lattice steps below the
+/// lattice point under the bracket to two above the one over it (within the range
+/// searched): where that preset puts the onset.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Relocated {
+    /// The window searched (r/min), on the search's lattice and bisection tolerance.
+    pub window_rpm: [f64; 2],
+    /// The tighter preset's onset in the window: the whirl side of its lowest transition
+    /// into whirl, bisected to `tol_rpm`. Null when the window holds none: whirl already at
+    /// its lower end, no whirl in it, or failed or unsettled drops (`note` says which).
+    pub onset_rpm: Option<f64>,
+    /// Drops run in the window (failed ones included).
+    pub drops: usize,
+    /// What the window shows, in words (`onset there 11437.5 r/min, 31.2 r/min lower`).
+    pub note: String,
 }
 
 impl Recheck {
     /// The two drops at the tighter preset, in words: `at standard: 13312.5 r/min
-    /// backward_whirl, 13375 r/min backward_whirl` (a failed drop reads `failed`).
+    /// backward_whirl, 13375 r/min backward_whirl` (a failed drop reads `failed`), then,
+    /// when the onset was searched again there, the window's note ([`Relocated::note`]).
     pub fn outcomes(&self) -> String {
         let show = |o: &Outcome| match o {
             Outcome::Class(c) => c.name().to_string(),
             Outcome::Failed(_) => "failed".to_string(),
         };
+        let relocated = match &self.relocated {
+            Some(r) => format!("; {}", r.note),
+            None => String::new(),
+        };
         format!(
-            "at {}: {} r/min {}, {} r/min {}",
+            "at {}: {} r/min {}, {} r/min {}{relocated}",
             self.fidelity,
             self.lo.0,
             show(&self.lo.1),
             self.hi.0,
             show(&self.hi.1)
         )
+    }
+
+    /// Drops the re-check ran: the bracket's two and the window's.
+    pub fn drops(&self) -> usize {
+        2 + self.relocated.as_ref().map_or(0, |r| r.drops)
     }
 
     /// Records this re-check in `row`. One the tighter preset does not confirm makes the row
@@ -321,6 +352,7 @@ mod tests {
             lo: (13312.5, Outcome::Class(OrbitClass::BackwardWhirl)),
             hi: (13375.0, Outcome::Failed("step_budget: x".into())),
             confirmed,
+            relocated: None,
         }
     }
 

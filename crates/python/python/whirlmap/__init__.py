@@ -295,7 +295,10 @@ def critical(
             does not confirm some row's onset bracket (the command line exits 1 then too);
             that row's ``converged`` is then false and its ``note`` says ``NOT CONFIRMED by
             the re-check`` (at its head, or at the end of an undecided row's note, which
-            starts with ``UNDECIDED``).
+            starts with ``UNDECIDED``). The search then runs again at the tighter preset
+            over at least two lattice steps either side of the bracket, and
+            ``recheck["relocated"]`` says where that preset puts the onset (``onset_rpm``,
+            null when not in that window, and a ``note`` that the row's note repeats).
 
     Raises:
         ValueError: A bad option, friction coefficient or scene parameter (named, with its
@@ -357,7 +360,8 @@ def critical(
         warnings.warn(
             "the re-check at the next tighter preset does not confirm the onset at "
             + ", ".join(unconfirmed)
-            + "; the onset at this preset is not to be trusted there (see each row's recheck)",
+            + "; the onset at this preset is not to be trusted there (each row's"
+            + " recheck says where the tighter preset puts it)",
             RuntimeWarning,
             stacklevel=2,
         )
