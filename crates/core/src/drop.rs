@@ -19,6 +19,9 @@ use std::ops::ControlFlow;
 /// Version of the model and its outputs; part of every record key. Bump it when a change
 /// alters results for the same scene.
 ///
+/// - 10: the event loop watches a guard that starts a step at exactly zero and locates its
+///   going below zero (before, a guard was watched only once positive: a contact that opened
+///   with its force exactly at zero and closed again went unseen).
 /// - 9: a guard that switched at an event (the located one included) switches once more
 ///   when another guard's switch at the same event sent it below zero (a stick that the race's
 ///   lift-off puts past its static limit ends at once).
@@ -46,7 +49,7 @@ use std::ops::ControlFlow;
 ///   classes describe the settled motion on a final window, undecided runs are extended,
 ///   and the whirl rule counts consecutive carried turns ([`crate::classify`]).
 /// - 2: a slip entered against the drifted slip velocity takes its sign.
-pub const MODEL_VERSION: u32 = 9;
+pub const MODEL_VERSION: u32 = 10;
 
 /// Largest first step after a mode switch (s): see [`Stepper::cap_next_step`].
 pub(crate) const STEP_AFTER_SWITCH_S: f64 = 1e-7;
@@ -618,6 +621,30 @@ fn run_with<O: Observer<DropSystem, N>, M: Stepper<N>>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rotor more than the clearance beyond the race with the contact not acting, as a
+    /// contact stepped over would leave it: the typed `unphysical` error. With the contact
+    /// acting, or with the race's centre within the clearance, it passes.
+    #[test]
+    fn a_rotor_through_the_race_with_the_contact_open_is_unphysical() {
+        let scene = Scene::paper();
+        let mut sys = DropSystem::new(&scene);
+        let s = sys.clearance_m();
+        let mut y = [0.0; N];
+        y[crate::model::ix::YR] = -3.0 * s;
+        sys.mode.contact = false;
+        match check_physical(&sys, &y, 0.5) {
+            Err(e @ SolveError::Unphysical { .. }) => {
+                assert!(e.to_string().contains("a contact was stepped over"), "{e}")
+            }
+            other => panic!("expected an unphysical error, got {other:?}"),
+        }
+        sys.mode.contact = true;
+        assert!(check_physical(&sys, &y, 0.5).is_ok());
+        sys.mode.contact = false;
+        y[crate::model::ix::YR] = -0.5 * s;
+        assert!(check_physical(&sys, &y, 0.5).is_ok());
+    }
 
     #[test]
     fn the_audit_closes_without_overflow_and_fails_on_a_non_finite_energy() {

@@ -91,9 +91,9 @@ where
 /// The jumps of the guards that crossed together with the located one, and of those the jump
 /// itself sent below zero.
 ///
-/// The driver watches a guard of a mode only once it is positive, so a guard that starts a
-/// mode at or below zero and stays there would never be seen, and the part of the mode it ends
-/// would hold with its guard violated. Two ways lead there:
+/// The driver watches a guard of a mode from zero or above (from exactly zero, it sees the
+/// guard go below), so a guard that starts a mode below zero would never be seen, and the part
+/// of the mode it ends would hold with its guard violated. Two ways lead there:
 /// - **Guards that cross together.** When the friction of a sticking contact is exactly zero
 ///   (a drop without spin), its friction guard `mu_s F_n - |F_t|` and the contact guard `F_n`
 ///   vanish at once. The stick ended, the contact stayed closed and pulled the rotor with a
@@ -121,7 +121,8 @@ where
 /// A guard exactly at zero that did not cross is a boundary the jump map itself decided: a
 /// contact entered with no force yet (an undamped contact starts at `F_n = 0`) sticks with a
 /// friction guard `mu_s F_n - |F_t|` of exactly 0 when no friction is needed; switching it to
-/// a slip there would start a slip whose own guard is 0 and never watched. A guard the first
+/// a slip there would start a slip whose own guard is 0. The driver watches it from zero, and
+/// it switches when it goes below. A guard the first
 /// jump made irrelevant (the friction guard once the contact is open) has no slot in the new
 /// mode. A guard that was already violated when the step began (`violated_before`: a
 /// crossing stepped over earlier, which the model's own checks report) is left as it was.
@@ -265,6 +266,30 @@ mod tests {
         run_toggling(a_at, b_at, b_after_a, 1.0, None)
     }
 
+    /// A jump's modes, from and to.
+    type Jump = ((bool, bool), (bool, bool));
+
+    /// Records every jump's modes.
+    #[derive(Default)]
+    struct Jumps(Vec<Jump>);
+
+    impl Observer<Latches, 1> for Jumps {
+        type Halt = std::convert::Infallible;
+    }
+
+    impl HybridObserver<Latches, 1> for Jumps {
+        fn on_jump(
+            &mut self,
+            _: &Latches,
+            _: f64,
+            _: &[f64; 1],
+            from: (bool, bool),
+            to: (bool, bool),
+        ) {
+            self.0.push((from, to));
+        }
+    }
+
     /// [`run`] with an open A's guard, alone and once B is open too.
     fn run_toggling(
         a_at: f64,
@@ -273,6 +298,17 @@ mod tests {
         a_open: f64,
         a_after_b: Option<f64>,
     ) -> (bool, bool) {
+        run_recorded(a_at, b_at, b_after_a, a_open, a_after_b).0
+    }
+
+    /// [`run_toggling`], with the modes every jump went from and to.
+    fn run_recorded(
+        a_at: f64,
+        b_at: f64,
+        b_after_a: Option<f64>,
+        a_open: f64,
+        a_after_b: Option<f64>,
+    ) -> ((bool, bool), Vec<Jump>) {
         let mut sys = Latches {
             a_at,
             b_at,
@@ -294,17 +330,18 @@ mod tests {
             max_events: 10,
             step_after_jump_s: 1e-3,
         };
+        let mut jumps = Jumps::default();
         run_hybrid(
             &mut sys,
             &mut stepper,
             &mut t,
             &mut y,
             1.0,
-            &mut NoObserver,
+            &mut jumps,
             &rules,
         )
         .unwrap();
-        sys.mode
+        (sys.mode, jumps.0)
     }
 
     #[test]
@@ -328,8 +365,20 @@ mod tests {
     fn a_located_guard_that_a_follow_on_jump_sends_negative_jumps_again() {
         // A's crossing is located and B crosses with it; B's jump sends the open A's guard to
         // -1, so A jumps back (closed). Its guard is then y - 0.5, at zero: it has jumped
-        // twice and is left there.
-        assert_eq!(run_toggling(0.5, 0.5, None, 1.0, Some(-1.0)), (true, false));
+        // twice at this event, and the driver watches it from zero, so it opens again at the
+        // next step, as y falls below 0.5.
+        let (open, closed) = (false, true);
+        let (end, jumps) = run_recorded(0.5, 0.5, None, 1.0, Some(-1.0));
+        assert_eq!(
+            jumps,
+            [
+                ((closed, closed), (open, closed)),
+                ((open, closed), (open, open)),
+                ((open, open), (closed, open)),
+                ((closed, open), (open, open)),
+            ]
+        );
+        assert_eq!(end, (open, open));
         // Sent exactly to zero: left alone, as for a first jump.
         assert_eq!(run_toggling(0.5, 0.5, None, 1.0, Some(0.0)), (false, false));
     }
@@ -342,6 +391,18 @@ mod tests {
             run_toggling(0.5, 0.5, None, -1.0, Some(-1.0)),
             (false, false)
         );
+    }
+
+    #[test]
+    fn a_guard_that_starts_at_zero_is_watched_from_there() {
+        // A's guard y - 1 is exactly zero at the start and falls below at once: A opens
+        // there. (Before, a guard was watched only once positive, and this one never was: a
+        // contact that opened with its force exactly at zero and closed again went unseen, and
+        // the rotor passed through the race.) One that stays at zero stays put (B's guard sent
+        // to 0 in `a_switch_that_sends_another_guard_negative_switches_it_too`).
+        let (end, jumps) = run_recorded(1.0, -1.0, None, 1.0, None);
+        assert_eq!(end, (false, true));
+        assert_eq!(jumps, [((true, true), (false, true))]);
     }
 
     #[test]

@@ -36,15 +36,17 @@ impl<S, const N: usize> Observer<S, N> for NoObserver {
 pub enum Stop<G, H> {
     /// The end time was reached.
     EndTime,
-    /// A guard crossed to `<= 0`; the returned state is just past the crossing.
+    /// A guard crossed to `<= 0` (or, from exactly zero at the step's start, to `< 0`); the
+    /// returned state is just past the crossing.
     Event {
         /// Which guard of the mode fired.
         guard: G,
         /// The other guards (by slot, as in [`OdeSystem::guards`]) that crossed in the same
-        /// step: positive at its start and `<= 0` at the returned state, so at the same
-        /// instant to the locator's resolution ([`super::run_hybrid`] takes their jumps too).
+        /// step: positive at its start and `<= 0` at the returned state (or zero and `< 0`),
+        /// so at the same instant to the locator's resolution ([`super::run_hybrid`] takes
+        /// their jumps too).
         crossed: [bool; MAX_GUARDS],
-        /// The guards that were already `<= 0` both at the start of the step and at the
+        /// The guards that were already below zero at the start of the step and `<= 0` at the
         /// returned state: a violation the step began with (a crossing stepped over before),
         /// not one it made.
         violated_before: [bool; MAX_GUARDS],
@@ -93,21 +95,34 @@ where
             sys.guards(tt, &dense.eval(tt), &mut g);
             g[i]
         };
-        // Earliest guard to cross to <= 0 within the step.
+        // Earliest guard to cross within the step: from > 0 to <= 0, or, for a guard that
+        // starts the step at exactly zero, from zero to < 0. A guard below zero at the step's
+        // start is not watched (a violation the model's own checks report).
         let mut first: Option<(usize, f64, f64)> = None;
         for i in 0..ng {
-            if g0[i] <= 0.0 {
+            if g0[i] < 0.0 {
                 continue;
             }
-            let bracket = if gm[i] <= 0.0 {
-                Some((dense.t0(), tm, g0[i], gm[i]))
-            } else if g1[i] <= 0.0 {
-                Some((tm, t1, gm[i], g1[i]))
+            // A guard at zero is located as if zero were above it: `crosses` is the side
+            // the crossing reaches, `lifted` the guard with zero counted on the near side.
+            let from_zero = g0[i] == 0.0;
+            let crosses = |v: f64| if from_zero { v < 0.0 } else { v <= 0.0 };
+            let lifted = |v: f64| {
+                if from_zero && v >= 0.0 {
+                    f64::MIN_POSITIVE
+                } else {
+                    v
+                }
+            };
+            let bracket = if crosses(gm[i]) {
+                Some((dense.t0(), tm, lifted(g0[i]), gm[i]))
+            } else if crosses(g1[i]) {
+                Some((tm, t1, lifted(gm[i]), g1[i]))
             } else {
                 None
             };
             if let Some((a, b, ga, gb)) = bracket {
-                let (lo, hi) = locate_crossing(|tt| guard_at(i, tt), a, b, ga, gb);
+                let (lo, hi) = locate_crossing(|tt| lifted(guard_at(i, tt)), a, b, ga, gb);
                 if first.is_none_or(|(_, _, h)| hi < h) {
                     first = Some((i, lo, hi));
                 }
@@ -124,8 +139,10 @@ where
                 let mut crossed = [false; MAX_GUARDS];
                 let mut violated_before = [false; MAX_GUARDS];
                 for j in 0..ng {
-                    crossed[j] = j != index && g0[j] > 0.0 && at_event[j] <= 0.0;
-                    violated_before[j] = g0[j] <= 0.0 && at_event[j] <= 0.0;
+                    crossed[j] = j != index
+                        && ((g0[j] > 0.0 && at_event[j] <= 0.0)
+                            || (g0[j] == 0.0 && at_event[j] < 0.0));
+                    violated_before[j] = g0[j] < 0.0 && at_event[j] <= 0.0;
                 }
                 let view = StepView { dense: cut };
                 // The observer sees the step up to the event; a break here is moot.
