@@ -5,9 +5,10 @@
 //! [`CriticalRow`]); `--csv FILE` also writes them as `critical.csv` does. Exit codes as the
 //! rest of the tool: 2 for bad input (validated before any drop runs), 4 when the CSV or
 //! standard output cannot be written. Failed drops are reported in each row; when they leave
-//! a row's onset undecided (`undecided`, see docs/critical-speed.md) the command still prints
-//! and writes every row, names the friction coefficients on standard error and exits 1, as a
-//! sweep whose points failed does.
+//! a row's onset undecided (`undecided`, see docs/critical-speed.md), or the `--fidelity`
+//! re-check does not confirm an onset, the command still prints and writes every row, names
+//! the friction coefficients on standard error and exits 1, as a sweep whose points failed
+//! does.
 //!
 //! `--log FILE` keeps every classified drop in FILE and answers from it the drops it already
 //! holds ([`DropLog::open_kept`]): a killed search run again does only what is missing, and
@@ -100,7 +101,7 @@ fn flag_error(e: InvalidParameter) -> Failure {
 }
 
 /// Runs the subcommand: `Flagged` (exit 1) when failed drops left some row's onset
-/// undecided, after every row is printed and written.
+/// undecided or the re-check did not confirm one, after every row is printed and written.
 pub fn run(a: &CriticalArgs) -> CmdResult {
     let opts = CriticalOptions {
         from_rpm: a.from,
@@ -200,8 +201,8 @@ pub(crate) fn report_unconfirmed(rows: &[CriticalRow]) -> bool {
     errln!(
         "error: the re-check at the next tighter preset does not confirm the onset at \
          {list}; the onset at this preset is not to be trusted there: where the tighter \
-         preset puts it, searched at least two lattice steps either side of the bracket, is in the \
-         row"
+         preset puts it, searched at least two lattice steps either side of the bracket within the \
+         searched range, is in the row"
     );
     true
 }

@@ -1,8 +1,9 @@
 //! `whirlmap merge DIR... [--out DIR]`: join the shards of a sweep into one result (see
 //! `whirlmap_sweep::merge`; the charts are drawn by `whirlmap_plot`).
 //!
-//! Exit codes: 0 merged, every point ok; 1 merged, some point failed (recorded as data) or
-//! failed drops left a critical speed undecided (its row says so); 2
+//! Exit codes: 0 merged, every point ok; 1 merged, some point failed (recorded as data),
+//! failed drops left a critical speed undecided or the re-check did not confirm an onset (its
+//! row says so); 2
 //! refused (a point missing or present twice, shards of different specs, shard counts,
 //! model versions or builds, a shard still running or with a file its manifest does not
 //! list, a folder that is not a shard's, an output folder holding another run's results
@@ -28,8 +29,8 @@ pub struct MergeArgs {
     overwrite: bool,
 }
 
-/// Runs the subcommand: `Flagged` (exit 1) when some points failed or failed drops left a
-/// critical speed undecided.
+/// Runs the subcommand: `Flagged` (exit 1) when some points failed, failed drops left a
+/// critical speed undecided or the re-check did not confirm an onset.
 pub fn run(a: &MergeArgs) -> CmdResult {
     let out = match &a.out {
         Some(o) => o.clone(),

@@ -1,7 +1,8 @@
 //! `whirlmap sweep FILE --shard I --shards N`: run one shard of a sweep (see
 //! `whirlmap_sweep::shard`). Exit codes as for a whole sweep: 0 every owned point ok, 1 some
-//! point failed or failed drops left an owned critical speed undecided (records still
-//! written), 2 bad input, 4 an output could not be written.
+//! point failed, failed drops left an owned critical speed undecided or the re-check did not
+//! confirm an owned onset (records still written), 2 bad input, 4 an output could not be
+//! written.
 
 use crate::sweep_cmd::{counts, critical_line, SweepArgs};
 use crate::{CmdResult, Done, Failure};

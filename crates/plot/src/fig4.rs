@@ -8,7 +8,8 @@
 //!   at the lowest scanned speed carries a downward arrow (at or below it); an onset that
 //!   failed or unsettled drops leave undecided (`undecided` in `critical.json`) is an open circle, joined
 //!   to no neighbour; an onset the re-check at a tighter preset did not confirm (`recheck` in
-//!   `critical.json`, not `confirmed`) is an open square, joined to no neighbour;
+//!   `critical.json`, not `confirmed`) is an open square (an open circle when it is undecided
+//!   too), joined to no neighbour;
 //! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
 //!   to the top of the searched range;
 //! - **no whirl in range** as an open triangle at the range top;
@@ -271,11 +272,17 @@ impl Figure for Fig4<'_> {
             let style = text_style(13.0)
                 .color(&NONE_MARK)
                 .pos(Pos::new(HPos::Left, VPos::Bottom));
-            // At the left edge, or in the widest gap between the columns' marks when it is
-            // there that the label fits (an arrow or a triangle at the first column's top
-            // would cross it at the edge).
+            // At the left end of the line, unless a column's arrow (whirl to the range top)
+            // would cross it there; then in the widest gap between arrows if it fits,
+            // else at the right end; at the left end when every place is crossed.
             let width = canvas.estimate_text_size(&label, &style)?.0 as i32;
-            let mut edges: Vec<i32> = rows.iter().map(|r| px(r.mu, t).0).collect();
+            let arrows: Vec<i32> = (rows.iter())
+                .filter(|r| r.whirl_at_range_top && !r.whirl_intervals_rpm.is_empty())
+                .map(|r| px(r.mu, t).0)
+                .collect();
+            let clear = |x: i32| arrows.iter().all(|&c| c + 8 < x || c - 8 > x + width);
+            // Gaps between arrows: a triangle (no whirl) sits below the label.
+            let mut edges = arrows.clone();
             edges.push(b.0);
             let gap = edges
                 .iter()
@@ -284,11 +291,14 @@ impl Figure for Fig4<'_> {
                     *left = right;
                     Some(g)
                 })
-                .max_by_key(|(l, r)| r - l);
-            let x = match gap {
-                Some((l, r)) if r - l >= width + 40 => (l + r - width) / 2,
-                _ => a.0 + 6,
-            };
+                .max_by_key(|(l, r)| r - l)
+                .filter(|(l, r)| r - l >= width + 40)
+                .map(|(l, r)| (l + r - width) / 2);
+            let x = [Some(a.0 + 6), gap, Some(b.0 - 6 - width)]
+                .into_iter()
+                .flatten()
+                .find(|&x| clear(x))
+                .unwrap_or(a.0 + 6);
             canvas.draw_text(&label, &style, (x, a.1 - 12))?;
         }
 

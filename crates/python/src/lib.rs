@@ -264,8 +264,9 @@ fn critical(
     let interrupted = |n| {
         format!(
             "critical search interrupted after {n} drops (its scan has {scan}, then \
-             bisections and, with a fidelity preset, two re-check drops per onset); nothing \
-             is returned"
+             bisections and, with a fidelity preset, two re-check drops per onset and a window \
+             search at the tighter preset for each onset they do not confirm); nothing is \
+             returned"
         )
     };
     let rows = interruptible(py, &pool, &cancel, interrupted, || {

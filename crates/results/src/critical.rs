@@ -253,7 +253,7 @@ pub struct Relocated {
     pub onset_rpm: Option<f64>,
     /// Drops run in the window (failed ones included).
     pub drops: usize,
-    /// What the window shows, in words (`onset there 11437.5 r/min, 31.2 r/min lower`).
+    /// What the window shows, in words (`its onset there 11437.5 r/min, 31.2 r/min lower`).
     pub note: String,
 }
 

@@ -4,7 +4,8 @@
 //! Those two cells decide the answer, so they are run again at the next tighter preset; the
 //! result says whether the tighter model agrees (non-whirl below, whirl above) and is
 //! recorded next to the bracket. When it does not agree, the search runs again at the
-//! tighter preset over at least two lattice steps either side of the bracket, to say where that
+//! tighter preset over at least two lattice steps either side of the bracket (within the range
+//! searched), to say where that
 //! preset puts the onset ([`Relocated`]).
 
 use crate::cancel::Cancel;

@@ -296,7 +296,7 @@ def critical(
             that row's ``converged`` is then false and its ``note`` says ``NOT CONFIRMED by
             the re-check`` (at its head, or at the end of an undecided row's note, which
             starts with ``UNDECIDED``). The search then runs again at the tighter preset
-            over at least two lattice steps either side of the bracket, and
+            over at least two lattice steps either side of the bracket (within the range), and
             ``recheck["relocated"]`` says where that preset puts the onset (``onset_rpm``,
             null when not in that window, and a ``note`` that the row's note repeats).
 
