@@ -171,7 +171,9 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
             duration_s: a.duration_s,
             ..Default::default()
         };
-        recheck_rows(&base, &mut rows, tighter, &drop_opts, None);
+        let ticker = Ticker::new(&format!("re-check at {tighter}"), 0, !a.no_progress);
+        recheck_rows(&base, &mut rows, tighter, &drop_opts, None, Some(&ticker));
+        ticker.finish();
     }
     let wall_s = start.elapsed().as_secs_f64();
     // The rows are printed first: a CSV that cannot be written (a full disk) loses nothing.

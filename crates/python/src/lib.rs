@@ -278,7 +278,7 @@ fn critical(
                 duration_s,
                 ..Default::default()
             };
-            recheck_rows(&base, &mut rows, tighter, &drop_opts, Some(&cancel));
+            recheck_rows(&base, &mut rows, tighter, &drop_opts, Some(&cancel), None);
             if cancel.requested() {
                 return Ok(None);
             }

@@ -251,7 +251,8 @@ pub struct Relocated {
     /// into whirl, bisected to `tol_rpm`. Null when the window holds none: whirl already at
     /// its lower end, no whirl in it, or failed or unsettled drops (`note` says which).
     pub onset_rpm: Option<f64>,
-    /// Drops run in the window (failed ones included).
+    /// Drops run in the window (failed ones included; the bracket's two, when the window
+    /// meets them, are not run again).
     pub drops: usize,
     /// What the window shows, in words (`its onset there 11437.5 r/min, 31.2 r/min lower`).
     pub note: String,

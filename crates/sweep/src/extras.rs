@@ -241,7 +241,8 @@ fn run_critical_ticked(
                 duration_s: spec.duration_s,
                 ..Default::default()
             };
-            crate::recheck::recheck_rows(&spec.base_scene(), &mut rows, tighter, &opts, None);
+            let base = spec.base_scene();
+            crate::recheck::recheck_rows(&base, &mut rows, tighter, &opts, None, Some(ticker));
         }
         if let Some(kept) = kept {
             // The searched rows take the undecided rows' places, in `mus`'s order.

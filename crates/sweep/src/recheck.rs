@@ -10,7 +10,9 @@
 
 use crate::cancel::Cancel;
 use crate::critical::{drop_outcome, fmt_rpm, search, CriticalOptions, CriticalRow, Outcome};
+use crate::progress::Ticker;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use whirlmap_core::classify::OrbitClass;
 use whirlmap_core::{DropOptions, Fidelity, Scene};
 
@@ -33,22 +35,33 @@ pub fn recheck_bracket(
 /// on `base` with the row's friction coefficient, and records each in its row
 /// ([`Recheck::apply_to`]: an unconfirmed bracket leaves the row not converged). With `cancel`, a drop not yet started
 /// when it is raised is skipped (its outcome "cancelled"; the caller discards the rows)
-/// and every drop run is counted on it.
+/// and every drop run is counted on it. Every drop run ticks `ticker`, which expects the
+/// brackets' two drops each (a window search's come on top).
 pub fn recheck_rows(
     base: &Scene,
     rows: &mut [CriticalRow],
     tighter: Fidelity,
     opts: &DropOptions,
     cancel: Option<&Cancel>,
+    ticker: Option<&Ticker>,
 ) {
-    let run = |s: &Scene, speed: f64| match cancel {
-        Some(c) if c.requested() => Outcome::Failed("cancelled".to_owned()),
-        Some(c) => {
-            let outcome = drop_outcome(s, speed, opts);
-            c.count_drop();
-            outcome
+    if let Some(t) = ticker {
+        t.expect_more(2 * rows.iter().filter(|r| r.bracket_rpm.is_some()).count());
+    }
+    let run = |s: &Scene, speed: f64| {
+        let outcome = match cancel {
+            Some(c) if c.requested() => return Outcome::Failed("cancelled".to_owned()),
+            Some(c) => {
+                let outcome = drop_outcome(s, speed, opts);
+                c.count_drop();
+                outcome
+            }
+            None => drop_outcome(s, speed, opts),
+        };
+        if let Some(t) = ticker {
+            t.tick();
         }
-        None => drop_outcome(s, speed, opts),
+        outcome
     };
     rows.par_iter_mut().for_each(|row| {
         let mut s = base.clone();
@@ -73,7 +86,7 @@ fn recheck_with(
     let settled_below =
         matches!(&out_lo, Outcome::Class(c) if !c.is_whirl() && *c != OrbitClass::Unresolved);
     let confirmed = settled_below && out_hi.whirl() == Some(true);
-    let relocated = (!confirmed).then(|| relocate(&s, row, run));
+    let relocated = (!confirmed).then(|| relocate(&s, row, [(lo, &out_lo), (hi, &out_hi)], run));
     Some(Recheck {
         fidelity: tighter,
         lo: (lo, out_lo),
@@ -92,13 +105,15 @@ const WINDOW_STEPS: f64 = 2.0;
 /// lattice steps below the lattice point under the bracket to as many above the one over it,
 /// within the range the row searched. Its ends are lattice points or the range's, so its
 /// scan drops are the ones a search of the whole range drops there, and it finds the onset
-/// that search would, when that onset is in the window.
+/// that search would, when that onset is in the window above its lower end. The bracket's
+/// two drops at the tighter preset (`known`) are not run again when the window meets them.
 fn relocate(
     tighter_scene: &Scene,
     row: &CriticalRow,
+    known: [(f64, &Outcome); 2],
     run: &(dyn Fn(&Scene, f64) -> Outcome + Sync),
 ) -> Relocated {
-    let [lo, hi] = row.bracket_rpm.expect("a re-checked row has a bracket");
+    let [(lo, _), (hi, _)] = known;
     let res = row.resolution_rpm;
     let from = (res * ((lo / res).floor() - WINDOW_STEPS)).max(row.from_rpm);
     let to = (res * ((hi / res).ceil() + WINDOW_STEPS)).min(row.to_rpm);
@@ -109,9 +124,26 @@ fn relocate(
         tol_rpm: row.tol_rpm,
         duration_s: row.duration_s,
     };
-    let found = search(|speed| run(tighter_scene, speed), &o)
-        .expect("a window inside a searched range is a valid search");
-    let w = found.into_row(row.mu, &o, String::new());
+    let ran = AtomicUsize::new(0);
+    let classify = |speed: f64| match known.iter().find(|(s, _)| *s == speed) {
+        Some((_, outcome)) => (*outcome).clone(),
+        None => {
+            ran.fetch_add(1, Ordering::Relaxed);
+            run(tighter_scene, speed)
+        }
+    };
+    // A row read back from a hand-edited file may hold a bracket outside its range.
+    let w = match search(classify, &o) {
+        Ok(found) => found.into_row(row.mu, &o, String::new()),
+        Err(e) => {
+            return Relocated {
+                window_rpm: [from, to],
+                onset_rpm: None,
+                drops: 0,
+                note: format!("not searched again there: {e}"),
+            }
+        }
+    };
     let (range_from, range_to) = (from <= row.from_rpm, to >= row.to_rpm);
     let (onset_rpm, note) = match (w.undecided, w.onset_rpm, w.bracket_rpm) {
         (true, _, _) => (
@@ -144,7 +176,8 @@ fn relocate(
         (false, Some(_), None) => (
             None,
             format!(
-                "whirl there already at {} r/min: its onset is lower, by more than two lattice steps",
+                "whirl there already at {} r/min, the window's lowest speed: its onset is there \
+                 or lower, two lattice steps or more below the bracket",
                 fmt_rpm(from)
             ),
         ),
@@ -166,7 +199,135 @@ fn relocate(
     Relocated {
         window_rpm: [from, to],
         onset_rpm,
-        drops: w.drops,
+        drops: ran.into_inner(),
         note,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::critical::search;
+    use std::sync::Mutex;
+    use OrbitClass::*;
+
+    /// A search of 1000-9000 r/min on a 250 r/min lattice to 10 r/min.
+    fn opts() -> CriticalOptions {
+        CriticalOptions {
+            from_rpm: 1000.0,
+            to_rpm: 9000.0,
+            resolution_rpm: 250.0,
+            tol_rpm: 10.0,
+            duration_s: 1.0,
+        }
+    }
+
+    /// Whirl from `threshold` up.
+    fn class_at(threshold: f64, speed: f64) -> Outcome {
+        Outcome::Class(if speed >= threshold {
+            BackwardWhirl
+        } else {
+            Pendulum
+        })
+    }
+
+    /// The row a search with whirl from `threshold` gives.
+    fn row(threshold: f64) -> CriticalRow {
+        let o = opts();
+        search(|s| class_at(threshold, s), &o)
+            .unwrap()
+            .into_row(0.3, &o, String::new())
+    }
+
+    /// The re-check of the row searched with whirl from `search_at`, at a "tighter preset"
+    /// with whirl from `tighter_at` (`fails` lists speeds whose drop fails there), and the
+    /// speeds it ran.
+    fn recheck(search_at: f64, tighter_at: f64, fails: &[f64]) -> (Recheck, Vec<f64>) {
+        let ran = Mutex::new(Vec::new());
+        let run = |_: &Scene, speed: f64| {
+            ran.lock().unwrap().push(speed);
+            if fails.contains(&speed) {
+                Outcome::Failed("step_budget: x".into())
+            } else {
+                class_at(tighter_at, speed)
+            }
+        };
+        let rc = recheck_with(&Scene::paper(), &row(search_at), Fidelity::Standard, &run)
+            .expect("a bracket");
+        (rc, ran.into_inner().unwrap())
+    }
+
+    #[test]
+    fn a_confirmed_bracket_searches_nothing_more() {
+        let (rc, ran) = recheck(4321.0, 4321.0, &[]);
+        assert!(rc.confirmed && rc.relocated.is_none());
+        assert_eq!(ran.len(), 2);
+    }
+
+    /// Where the tighter preset puts the onset inside the window is where a search of the
+    /// whole range with it does, lower or higher; the bracket's two drops are not run again.
+    #[test]
+    fn an_onset_in_the_window_is_the_whole_range_search_s() {
+        for tighter_at in [4100.0, 4600.0] {
+            let (rc, ran) = recheck(4321.0, tighter_at, &[]);
+            let w = rc.relocated.expect("searched again");
+            assert!(!rc.confirmed);
+            assert_eq!(
+                w.window_rpm,
+                [3750.0, 5000.0],
+                "two steps below 4250, above 4500"
+            );
+            assert_eq!(w.onset_rpm, row(tighter_at).onset_rpm);
+            let side = if tighter_at < 4321.0 {
+                "lower"
+            } else {
+                "higher"
+            };
+            assert!(w.note.ends_with(side), "{}", w.note);
+            assert_eq!(w.drops, ran.len() - 2);
+            let [lo, hi] = row(4321.0).bracket_rpm.unwrap();
+            assert_eq!(ran.iter().filter(|&&s| s == lo || s == hi).count(), 2);
+        }
+    }
+
+    /// A bracket end on the lattice is a scan point of the window: its drop is not run again.
+    #[test]
+    fn the_window_reuses_the_bracket_s_drops() {
+        let [lo, _] = row(4255.0).bracket_rpm.unwrap();
+        assert_eq!(lo, 4250.0, "every bisection midpoint whirled");
+        let (rc, ran) = recheck(4255.0, 4600.0, &[]);
+        assert_eq!(ran.iter().filter(|&&s| s == lo).count(), 1, "{ran:?}");
+        assert_eq!(rc.relocated.unwrap().drops, ran.len() - 2);
+    }
+
+    /// Whirl at the window's lowest speed, or none in it: no onset there, and the note says
+    /// which side and whether the window reached the range's end.
+    #[test]
+    fn an_onset_outside_the_window_is_named_by_its_side() {
+        let note = |search_at: f64, tighter_at: f64| {
+            let w = recheck(search_at, tighter_at, &[]).0.relocated.unwrap();
+            assert_eq!(w.onset_rpm, None);
+            w.note
+        };
+        assert!(
+            note(4321.0, 2000.0).contains("the window's lowest speed: its onset is there or lower")
+        );
+        assert!(note(1300.0, 500.0).contains("at the range's lowest speed, 1000 r/min"));
+        assert!(
+            note(4321.0, 7000.0).contains("its onset is higher, by more than two lattice steps")
+        );
+        assert!(note(8600.0, 9500.0).contains("no whirl there from 8000 r/min to the range top"));
+    }
+
+    #[test]
+    fn failed_drops_in_the_window_leave_its_onset_undecided() {
+        let (rc, _) = recheck(4321.0, 4100.0, &[4000.0]);
+        let w = rc.relocated.unwrap();
+        assert_eq!(w.onset_rpm, None);
+        assert!(
+            w.note.contains("undecided in 3750-5000 r/min"),
+            "{}",
+            w.note
+        );
     }
 }

@@ -133,7 +133,26 @@ mod tests {
         for omega in [-900.0, -50.0, 30.0, 400.0, 3000.0, 0.5] {
             for load in [0.0, 3.0, 500.0, 20_000.0] {
                 let (m, dw, dl) = b.torque_and_slopes(omega, load);
-                assert_eq!(m.to_bits(), b.torque_n_m(omega, load).to_bits());
+                // The bits of the formulas as written before the powers were shared.
+                let x = b.nu0_mm2_s * f64::abs(omega) * RAD_S_TO_RPM;
+                let m0 = 1e-7 * b.f0 * x.powf(2.0 / 3.0).max(160.0) * b.dm_mm.powi(3) * 1e-3;
+                let p = f64::max(load, 0.0);
+                let m1 = if p == 0.0 {
+                    0.0
+                } else {
+                    0.001 * (p / b.c0_n).powf(0.33) * p * b.dm_mm * 1e-3
+                };
+                assert_eq!(m.to_bits(), (m0 + m1).to_bits());
+                let old_dw = if omega != 0.0 && x.powf(2.0 / 3.0) > 160.0 {
+                    (2.0 / 3.0) * m0 / omega
+                } else {
+                    0.0
+                };
+                let old_dl = if load > 0.0 { 1.33 * m1 / load } else { 0.0 };
+                assert_eq!(
+                    (dw.to_bits(), dl.to_bits()),
+                    (old_dw.to_bits(), old_dl.to_bits())
+                );
                 let h = 1e-6 * f64::abs(omega);
                 let fd_w =
                     (b.torque_n_m(omega + h, load) - b.torque_n_m(omega - h, load)) / (2.0 * h);
