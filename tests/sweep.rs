@@ -882,3 +882,43 @@ fn a_resumed_critical_search_uses_exactly_the_logged_drops_of_its_scenes() {
     assert!(!out.join("critical-drops.jsonl").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `sweeps/critical-draft-checked.json` (docs/critical-speed.md#screening-at-draft-checked-at-standard):
+/// the main job's critical search at `draft`, re-checked at `standard`. Every onset the
+/// re-check confirms or finds in its window is the committed main job's (`results/paper`, a
+/// `standard` search of the whole range), to the bit, and the sweep exits 1 for those it
+/// does not confirm.
+#[test]
+fn a_draft_search_rechecked_at_standard_finds_the_main_job_s_onsets() {
+    let dir = temp_dir("draft-checked");
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/critical-draft-checked.json");
+    let o = whirlmap(&["sweep", s(&spec), "--out", s(&dir), "--no-progress"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let rows = read_json(&dir.join("critical.json"));
+    let main =
+        read_json(&Path::new(env!("CARGO_MANIFEST_DIR")).join("results/paper/critical.json"));
+    let (mut confirmed, mut found) = (0, 0);
+    for (r, m) in rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(main.as_array().unwrap())
+    {
+        assert_eq!(r["mu"], m["mu"]);
+        let Some(rc) = r.get("recheck") else {
+            continue;
+        };
+        if rc["confirmed"] == true {
+            confirmed += 1;
+            assert_eq!(r["onset_rpm"], m["onset_rpm"], "{r}");
+        } else if let Some(onset) = rc["relocated"]["onset_rpm"].as_f64() {
+            found += 1;
+            assert_eq!(Some(onset), m["onset_rpm"].as_f64(), "{r}");
+        }
+    }
+    assert!(
+        confirmed >= 1 && found >= 1,
+        "{confirmed} confirmed, {found} found"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
