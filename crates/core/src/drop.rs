@@ -20,8 +20,10 @@ use std::ops::ControlFlow;
 /// alters results for the same scene.
 ///
 /// - 10: the event loop watches a guard that starts a step at exactly zero and locates its
-///   going below zero (before, a guard was watched only once positive: a contact that opened
-///   with its force exactly at zero and closed again went unseen).
+///   going below zero, and a guard at zero when a step starts that is below zero at another
+///   guard's event takes its own switch there (before, a guard was watched only once
+///   positive: a contact whose guard reached exactly zero, the penetration exactly 0 at a
+///   graze, and closed again went unseen, and the rotor fell through the race).
 /// - 9: a guard that switched at an event (the located one included) switches once more
 ///   when another guard's switch at the same event sent it below zero (a stick that the race's
 ///   lift-off puts past its static limit ends at once).

@@ -155,8 +155,8 @@ impl DropSystem {
     /// Also sets the initial mode (rotor free, race on its support). Without gravity the race
     /// starts centred, where its zero-clearance support carries no force yet, and it is on
     /// its support all the same: the balls push it back as soon as it moves (starting it off
-    /// its support there, the support's guard started at zero and the race ran free of its
-    /// balls for the whole drop).
+    /// its support there, the support's guard started at zero, and before model version 10,
+    /// which watches a guard from zero, the race ran free of its balls for the whole drop).
     pub fn initial_state(&mut self, spin_rad_s: f64) -> [f64; N] {
         let mut y = [0.0; N];
         y[ix::WR] = spin_rad_s;

@@ -128,8 +128,8 @@ impl DropSystem {
     /// contact holds `v_rel` only through its acceleration, so `v_rel` drifts by the
     /// integration error while it sticks, and a reversal is located only to within the root
     /// tolerance. If that small `v_rel` points against the demand, the new mode's guard
-    /// (`sign * v_rel`) starts negative; the event loop watches guards crossing from positive
-    /// to zero, so it would never see it, and the friction, pushing along the slip instead of
+    /// (`sign * v_rel`) starts negative; the event loop watches a guard only from zero or
+    /// above, so it would never see it, and the friction, pushing along the slip instead of
     /// against it, would make energy (measured before this rule: -1085 J of "friction heat"
     /// in a 1 s drop at a loose tolerance). So the slip takes the sign of `v_rel` there:
     /// friction then opposes it, `v_rel` returns through zero at once, and that reversal

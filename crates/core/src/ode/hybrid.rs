@@ -397,12 +397,112 @@ mod tests {
     fn a_guard_that_starts_at_zero_is_watched_from_there() {
         // A's guard y - 1 is exactly zero at the start and falls below at once: A opens
         // there. (Before, a guard was watched only once positive, and this one never was: a
-        // contact that opened with its force exactly at zero and closed again went unseen, and
+        // grazing contact whose guard reached exactly zero and closed again went unseen, and
         // the rotor passed through the race.) One that stays at zero stays put (B's guard sent
         // to 0 in `a_switch_that_sends_another_guard_negative_switches_it_too`).
         let (end, jumps) = run_recorded(1.0, -1.0, None, 1.0, None);
         assert_eq!(end, (false, true));
         assert_eq!(jumps, [((true, true), (false, true))]);
+    }
+
+    #[test]
+    fn guards_that_start_at_zero_and_fall_together_both_switch() {
+        // Both guards are y - 1, at zero at the start: A's fall is located, and B, at zero
+        // when the step began and below zero at A's event, takes its own switch with it.
+        assert_eq!(run(1.0, 1.0, None), (false, false));
+    }
+
+    /// One guard, flat at exactly zero until `y = 0.63` and below zero after it, over
+    /// `y' = 1` from 0 in steps of at most 0.05: zero at the starts of a dozen steps, at the
+    /// midpoint of the step that leaves it, where the crossing is in the step's second half.
+    struct Flat {
+        open: bool,
+    }
+
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    enum Edge {
+        Leave,
+    }
+
+    impl GuardSet for Edge {
+        const ALL: &'static [Self] = &[Edge::Leave];
+    }
+
+    impl OdeSystem<1> for Flat {
+        type Guard = Edge;
+        fn rhs(&self, _t: f64, _y: &[f64; 1], dy: &mut [f64; 1]) {
+            dy[0] = 1.0;
+        }
+        fn guards(&self, _t: f64, y: &[f64; 1], g: &mut [f64; MAX_GUARDS]) -> usize {
+            g[0] = match (self.open, y[0] < 0.63) {
+                (true, _) => 1.0,
+                (false, true) => 0.0,
+                (false, false) => 0.63 - y[0],
+            };
+            1
+        }
+        fn max_step(&self) -> f64 {
+            0.05
+        }
+    }
+
+    impl Hybrid<1> for Flat {
+        type Mode = bool;
+        fn mode(&self) -> bool {
+            self.open
+        }
+        fn set_mode(&mut self, open: bool) {
+            self.open = open;
+        }
+        fn jump(&self, _: Edge, _: &[f64; 1]) -> bool {
+            true
+        }
+    }
+
+    /// Records the times of the jumps.
+    #[derive(Default)]
+    struct Times(Vec<f64>);
+
+    impl Observer<Flat, 1> for Times {
+        type Halt = std::convert::Infallible;
+    }
+
+    impl HybridObserver<Flat, 1> for Times {
+        fn on_jump(&mut self, _: &Flat, t: f64, _: &[f64; 1], _: bool, _: bool) {
+            self.0.push(t);
+        }
+    }
+
+    #[test]
+    fn a_guard_flat_at_zero_is_located_where_it_leaves_zero() {
+        let mut sys = Flat { open: false };
+        let ctl = StepControl {
+            rtol: 1e-9,
+            atol: [1e-12],
+            h_min: 1e-14,
+            max_attempts: 10_000,
+            fixed_step: None,
+        };
+        let mut stepper = Dopri5::new(ctl);
+        let (mut t, mut y) = (0.0, [0.0]);
+        let rules = JumpRules {
+            max_events: 10,
+            step_after_jump_s: 1e-3,
+        };
+        let mut times = Times::default();
+        run_hybrid(
+            &mut sys,
+            &mut stepper,
+            &mut t,
+            &mut y,
+            1.0,
+            &mut times,
+            &rules,
+        )
+        .unwrap();
+        assert_eq!(times.0.len(), 1, "{:?}", times.0);
+        assert!((times.0[0] - 0.63).abs() < 1e-12, "{:?}", times.0);
+        assert!(sys.open);
     }
 
     #[test]
