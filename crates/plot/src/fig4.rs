@@ -404,11 +404,9 @@ mod tests {
         }
     }
 
-    /// An undecided onset is joined to no neighbour, and the chart draws it (as an open
-    /// circle, with its legend entry) where a decided onset would be a filled dot. The picture
-    /// is kept under the temp folder when `WHIRLMAP_KEEP_CHART` is set, to be looked at.
-    #[test]
-    fn an_undecided_onset_is_not_joined_and_is_drawn_apart() {
+    /// The main job's committed critical rows in order of mu, and the index of mu 0.4 (an
+    /// onset joined to both neighbours).
+    fn paper_rows_at_mu_0_4() -> (Vec<CriticalRow>, usize) {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/paper");
         let mut rows = whirlmap_results::critical::read_critical(&dir)
             .expect("committed critical.json")
@@ -418,6 +416,15 @@ mod tests {
             .iter()
             .position(|r| (r.mu - 0.4).abs() < 1e-9)
             .expect("mu 0.4");
+        (rows, i)
+    }
+
+    /// An undecided onset is joined to no neighbour, and the chart draws it (as an open
+    /// circle, with its legend entry) where a decided onset would be a filled dot. The picture
+    /// is kept under the temp folder when `WHIRLMAP_KEEP_CHART` is set, to be looked at.
+    #[test]
+    fn an_undecided_onset_is_not_joined_and_is_drawn_apart() {
+        let (mut rows, i) = paper_rows_at_mu_0_4();
         assert!(joined(&rows[i - 1], &rows[i]) && joined(&rows[i], &rows[i + 1]));
         rows[i].undecided = true;
         rows[i].converged = false;
@@ -457,15 +464,7 @@ mod tests {
         use whirlmap_core::classify::OrbitClass;
         use whirlmap_core::Fidelity;
         use whirlmap_results::critical::{Outcome, Recheck};
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/paper");
-        let mut rows = whirlmap_results::critical::read_critical(&dir)
-            .expect("committed critical.json")
-            .expect("a critical search");
-        rows.sort_by(|a, b| a.mu.total_cmp(&b.mu));
-        let i = rows
-            .iter()
-            .position(|r| (r.mu - 0.4).abs() < 1e-9)
-            .expect("mu 0.4");
+        let (rows, i) = paper_rows_at_mu_0_4();
         let [lo, hi] = rows[i].bracket_rpm.expect("a bracket");
         let recheck = |confirmed: bool| Recheck {
             fidelity: Fidelity::Reference,

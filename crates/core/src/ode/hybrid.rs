@@ -261,6 +261,23 @@ mod tests {
         }
     }
 
+    /// The toy systems' stepper: DOPRI5 at rtol 1e-9.
+    fn toy_stepper() -> Dopri5<1> {
+        Dopri5::new(StepControl {
+            rtol: 1e-9,
+            atol: [1e-12],
+            h_min: 1e-14,
+            max_attempts: 10_000,
+            fixed_step: None,
+        })
+    }
+
+    /// The toy systems' jump rules.
+    const TOY_RULES: JumpRules = JumpRules {
+        max_events: 10,
+        step_after_jump_s: 1e-3,
+    };
+
     /// The mode at t = 1 (y = 0) after starting with both latches closed.
     fn run(a_at: f64, b_at: f64, b_after_a: Option<f64>) -> (bool, bool) {
         run_toggling(a_at, b_at, b_after_a, 1.0, None)
@@ -317,19 +334,8 @@ mod tests {
             a_after_b,
             mode: (true, true),
         };
-        let ctl = StepControl {
-            rtol: 1e-9,
-            atol: [1e-12],
-            h_min: 1e-14,
-            max_attempts: 10_000,
-            fixed_step: None,
-        };
-        let mut stepper = Dopri5::new(ctl);
+        let mut stepper = toy_stepper();
         let (mut t, mut y) = (0.0, [1.0]);
-        let rules = JumpRules {
-            max_events: 10,
-            step_after_jump_s: 1e-3,
-        };
         let mut jumps = Jumps::default();
         run_hybrid(
             &mut sys,
@@ -338,7 +344,7 @@ mod tests {
             &mut y,
             1.0,
             &mut jumps,
-            &rules,
+            &TOY_RULES,
         )
         .unwrap();
         (sys.mode, jumps.0)
@@ -476,19 +482,8 @@ mod tests {
     #[test]
     fn a_guard_flat_at_zero_is_located_where_it_leaves_zero() {
         let mut sys = Flat { open: false };
-        let ctl = StepControl {
-            rtol: 1e-9,
-            atol: [1e-12],
-            h_min: 1e-14,
-            max_attempts: 10_000,
-            fixed_step: None,
-        };
-        let mut stepper = Dopri5::new(ctl);
+        let mut stepper = toy_stepper();
         let (mut t, mut y) = (0.0, [0.0]);
-        let rules = JumpRules {
-            max_events: 10,
-            step_after_jump_s: 1e-3,
-        };
         let mut times = Times::default();
         run_hybrid(
             &mut sys,
@@ -497,7 +492,7 @@ mod tests {
             &mut y,
             1.0,
             &mut times,
-            &rules,
+            &TOY_RULES,
         )
         .unwrap();
         assert_eq!(times.0.len(), 1, "{:?}", times.0);
