@@ -897,15 +897,15 @@ fn a_draft_search_rechecked_at_standard_finds_the_main_job_s_onsets() {
     let rows = read_json(&dir.join("critical.json"));
     let main =
         read_json(&Path::new(env!("CARGO_MANIFEST_DIR")).join("results/paper/critical.json"));
+    let (rows, main) = (rows.as_array().unwrap(), main.as_array().unwrap());
+    assert_eq!(rows.len(), main.len());
     let (mut confirmed, mut found) = (0, 0);
-    for (r, m) in rows
-        .as_array()
-        .unwrap()
-        .iter()
-        .zip(main.as_array().unwrap())
-    {
+    for (r, m) in rows.iter().zip(main) {
         assert_eq!(r["mu"], m["mu"]);
         let Some(rc) = r.get("recheck") else {
+            // No bracket: no whirl in the range, in both.
+            let null = serde_json::Value::Null;
+            assert_eq!((&r["onset_rpm"], &m["onset_rpm"]), (&null, &null), "{r}");
             continue;
         };
         if rc["confirmed"] == true {
@@ -920,5 +920,9 @@ fn a_draft_search_rechecked_at_standard_finds_the_main_job_s_onsets() {
         confirmed >= 1 && found >= 1,
         "{confirmed} confirmed, {found} found"
     );
+    // mu 0.25, where `draft` is 17 % high: not confirmed, and outside the window.
+    let r = rows.iter().find(|r| r["mu"] == 0.25).unwrap();
+    assert_eq!(r["recheck"]["confirmed"], false, "{r}");
+    assert!(r["recheck"]["relocated"]["onset_rpm"].is_null(), "{r}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

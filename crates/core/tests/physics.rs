@@ -1413,9 +1413,9 @@ fn a_drop_without_gravity_is_the_limit_of_a_vanishing_gravity() {
 /// A contact 5e6 times stiffer than the paper's at the default numerics, without friction:
 /// the rotor once fell through the race (19 m in 2 s) and the drop passed its energy audit;
 /// model version 8 failed it with the typed `unphysical` error ("a contact was stepped
-/// over"). The cause was the event loop's, not the stiffness: the contact opened where its
-/// force was exactly zero, and the loop watched a guard only once positive (version 10
-/// watches it from zero). It now rocks at the bottom like the paper's rotor, its energy books
+/// over"). The cause was the event loop's, not the stiffness: the contact's guard reached
+/// exactly zero (penetration exactly 0 at a graze), and the loop watched a guard only once
+/// positive (version 10 watches it from zero). It now rocks at the bottom like the paper's rotor, its energy books
 /// closed. (The check itself: `a_rotor_through_the_race_with_the_contact_open_is_unphysical`
 /// in `drop.rs`.) Two deep penetrations that are not a stepped-over contact pass: a contact
 /// the damper opened while still overlapping (never-pull rule, at g = 0 after a fast lateral

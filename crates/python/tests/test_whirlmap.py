@@ -371,8 +371,8 @@ def test_ctrl_c_stops_a_critical_search_before_its_end() -> None:
         )
     m = re.fullmatch(
         r"critical search interrupted after (\d+) drops \(its scan has (\d+), then "
-        r"bisections and, with a fidelity preset, two re-check drops per onset\); "
-        r"nothing is returned",
+        r"bisections and, with a fidelity preset, two re-check drops per onset and a window "
+        r"search at the tighter preset for each onset they do not confirm\); nothing is returned",
         str(info.value),
     )
     assert m is not None, str(info.value)

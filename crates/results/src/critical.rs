@@ -249,7 +249,9 @@ pub struct Relocated {
     pub window_rpm: [f64; 2],
     /// The tighter preset's onset in the window: the whirl side of its lowest transition
     /// into whirl, bisected to `tol_rpm`. Null when the window holds none: whirl already at
-    /// its lower end, no whirl in it, or failed or unsettled drops (`note` says which).
+    /// its lower end, no whirl in it, or failed or unsettled drops; or when the window was not
+    /// searched (a row read from a file whose bracket lies outside its range). `note` says
+    /// which.
     pub onset_rpm: Option<f64>,
     /// Drops run in the window (failed ones included; the bracket's two, when the window
     /// meets them, are not run again).

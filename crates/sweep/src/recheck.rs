@@ -124,6 +124,7 @@ fn relocate(
         tol_rpm: row.tol_rpm,
         duration_s: row.duration_s,
     };
+    // Drops run (a cancelled one counts too; a cancelled run's rows are discarded).
     let ran = AtomicUsize::new(0);
     let classify = |speed: f64| match known.iter().find(|(s, _)| *s == speed) {
         Some((_, outcome)) => (*outcome).clone(),
@@ -290,7 +291,8 @@ mod tests {
         }
     }
 
-    /// A bracket end on the lattice is a scan point of the window: its drop is not run again.
+    /// A bracket end the window meets again, as a scan point (an end on the lattice) or as a
+    /// bisection midpoint, is not run again.
     #[test]
     fn the_window_reuses_the_bracket_s_drops() {
         let [lo, _] = row(4255.0).bracket_rpm.unwrap();
@@ -298,6 +300,32 @@ mod tests {
         let (rc, ran) = recheck(4255.0, 4600.0, &[]);
         assert_eq!(ran.iter().filter(|&&s| s == lo).count(), 1, "{ran:?}");
         assert_eq!(rc.relocated.unwrap().drops, ran.len() - 2);
+        // Whirl from 4370 at the tighter preset: its bisection of [4250, 4500] passes 4375,
+        // the search's lower bracket end.
+        let [lo, _] = row(4380.0).bracket_rpm.unwrap();
+        assert_eq!(lo, 4375.0);
+        let (rc, ran) = recheck(4380.0, 4370.0, &[]);
+        assert_eq!(ran.iter().filter(|&&s| s == lo).count(), 1, "{ran:?}");
+        let w = rc.relocated.unwrap();
+        assert_eq!(w.onset_rpm, row(4370.0).onset_rpm);
+        assert_eq!(w.drops, ran.len() - 2);
+    }
+
+    /// A row whose bracket lies outside its own range (a hand-edited file) is not searched
+    /// again, and the note says why; nothing panics.
+    #[test]
+    fn a_bracket_outside_its_range_gives_a_note() {
+        let mut r = row(4321.0);
+        r.from_rpm = 5000.0;
+        let run = |_: &Scene, speed: f64| class_at(4100.0, speed);
+        let rc = recheck_with(&Scene::paper(), &r, Fidelity::Standard, &run).unwrap();
+        let w = rc.relocated.unwrap();
+        assert_eq!((w.onset_rpm, w.drops), (None, 0));
+        assert!(
+            w.note.starts_with("not searched again there: "),
+            "{}",
+            w.note
+        );
     }
 
     /// Whirl at the window's lowest speed, or none in it: no onset there, and the note says

@@ -261,15 +261,20 @@ mod tests {
         }
     }
 
-    /// The toy systems' stepper: DOPRI5 at rtol 1e-9.
-    fn toy_stepper() -> Dopri5<1> {
-        Dopri5::new(StepControl {
+    /// The toy systems' step control: rtol 1e-9, adaptive.
+    fn toy_stepper_control() -> StepControl<1> {
+        StepControl {
             rtol: 1e-9,
             atol: [1e-12],
             h_min: 1e-14,
             max_attempts: 10_000,
             fixed_step: None,
-        })
+        }
+    }
+
+    /// The toy systems' stepper: DOPRI5 on [`toy_stepper_control`].
+    fn toy_stepper() -> Dopri5<1> {
+        Dopri5::new(toy_stepper_control())
     }
 
     /// The toy systems' jump rules.
@@ -419,8 +424,9 @@ mod tests {
     }
 
     /// One guard, flat at exactly zero until `y = 0.63` and below zero after it, over
-    /// `y' = 1` from 0 in steps of at most 0.05: zero at the starts of a dozen steps, at the
-    /// midpoint of the step that leaves it, where the crossing is in the step's second half.
+    /// `y' = 1` from 0 in fixed steps of 0.05: zero at the starts of thirteen steps and at the
+    /// midpoint (0.625) of the step that leaves it, [0.60, 0.65], where the crossing is in the
+    /// step's second half.
     struct Flat {
         open: bool,
     }
@@ -482,7 +488,10 @@ mod tests {
     #[test]
     fn a_guard_flat_at_zero_is_located_where_it_leaves_zero() {
         let mut sys = Flat { open: false };
-        let mut stepper = toy_stepper();
+        let mut stepper = Dopri5::new(StepControl {
+            fixed_step: Some(0.05),
+            ..toy_stepper_control()
+        });
         let (mut t, mut y) = (0.0, [0.0]);
         let mut times = Times::default();
         run_hybrid(
