@@ -242,10 +242,12 @@ pub struct Recheck {
 /// The search run again at the re-check's tighter preset when that preset does not confirm
 /// the bracket, on the search's lattice and tolerance, from two lattice steps below the
 /// lattice point under the bracket to two above the one over it (within the range
-/// searched): where that preset puts the onset.
+/// searched), each side widened, doubling its steps up to sixteen, while the onset lies beyond
+/// it: where that preset puts the onset.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Relocated {
-    /// The window searched (r/min), on the search's lattice and bisection tolerance.
+    /// The window searched last, the widest (r/min), on the search's lattice and bisection
+    /// tolerance.
     pub window_rpm: [f64; 2],
     /// The tighter preset's onset in the window: the whirl side of its lowest transition
     /// into whirl, bisected to `tol_rpm`. Null when the window holds none: whirl already at

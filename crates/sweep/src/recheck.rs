@@ -5,14 +5,15 @@
 //! result says whether the tighter model agrees (non-whirl below, whirl above) and is
 //! recorded next to the bracket. When it does not agree, the search runs again at the
 //! tighter preset over at least two lattice steps either side of the bracket (within the range
-//! searched), to say where that
-//! preset puts the onset ([`Relocated`]).
+//! searched; up to sixteen), to say where that preset puts the onset ([`Relocated`]).
 
 use crate::cancel::Cancel;
 use crate::critical::{drop_outcome, fmt_rpm, search, CriticalOptions, CriticalRow, Outcome};
 use crate::progress::Ticker;
 use rayon::prelude::*;
+use std::collections::HashMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 use whirlmap_core::classify::OrbitClass;
 use whirlmap_core::{DropOptions, Fidelity, Scene};
 
@@ -96,17 +97,23 @@ fn recheck_with(
     })
 }
 
-/// Lattice steps either side of the bracket that [`relocate`] searches: the convergence
+/// Lattice steps either side of the bracket that [`relocate`] searches first: the convergence
 /// study's tolerance on an onset (docs/accuracy.md).
 const WINDOW_STEPS: f64 = 2.0;
+
+/// Lattice steps either side of the bracket that [`relocate`] widens its window to, at most.
+const MAX_WINDOW_STEPS: f64 = 16.0;
 
 /// Searches `row`'s bracket again on `tighter_scene` (the tighter preset's, with the row's
 /// friction coefficient) on its lattice and tolerance, over a window from [`WINDOW_STEPS`]
 /// lattice steps below the lattice point under the bracket to as many above the one over it,
-/// within the range the row searched. Its ends are lattice points or the range's, so its
+/// within the range the row searched. When the tighter preset whirls at the window's lowest
+/// speed (or does not at its highest), that side is widened, doubling its steps up to
+/// [`MAX_WINDOW_STEPS`], and searched again. Its ends are lattice points or the range's, so its
 /// scan drops are the ones a search of the whole range drops there, and it finds the onset
-/// that search would, when that onset is in the window above its lower end. The bracket's
-/// two drops at the tighter preset (`known`) are not run again when the window meets them.
+/// that search would, when that onset is in the window above its lower end. No drop runs
+/// twice: the bracket's two at the tighter preset (`known`) and every drop of a narrower
+/// window are answered from memory.
 fn relocate(
     tighter_scene: &Scene,
     row: &CriticalRow,
@@ -115,34 +122,58 @@ fn relocate(
 ) -> Relocated {
     let [(lo, _), (hi, _)] = known;
     let res = row.resolution_rpm;
-    let from = (res * ((lo / res).floor() - WINDOW_STEPS)).max(row.from_rpm);
-    let to = (res * ((hi / res).ceil() + WINDOW_STEPS)).min(row.to_rpm);
-    let o = CriticalOptions {
-        from_rpm: from,
-        to_rpm: to,
-        resolution_rpm: row.resolution_rpm,
-        tol_rpm: row.tol_rpm,
-        duration_s: row.duration_s,
-    };
-    // Drops run (a cancelled one counts too; a cancelled run's rows are discarded).
+    // Every outcome so far by the speed's bits, and the drops run (a cancelled one counts
+    // too; a cancelled run's rows are discarded).
+    let memo: Mutex<HashMap<u64, Outcome>> = Mutex::new(
+        (known.iter())
+            .map(|(s, o)| (s.to_bits(), (*o).clone()))
+            .collect(),
+    );
     let ran = AtomicUsize::new(0);
-    let classify = |speed: f64| match known.iter().find(|(s, _)| *s == speed) {
-        Some((_, outcome)) => (*outcome).clone(),
-        None => {
-            ran.fetch_add(1, Ordering::Relaxed);
-            run(tighter_scene, speed)
+    let classify = |speed: f64| {
+        if let Some(o) = memo
+            .lock()
+            .expect("no panic holds it")
+            .get(&speed.to_bits())
+        {
+            return o.clone();
         }
+        ran.fetch_add(1, Ordering::Relaxed);
+        let o = run(tighter_scene, speed);
+        memo.lock()
+            .expect("no panic holds it")
+            .insert(speed.to_bits(), o.clone());
+        o
     };
-    // A row read back from a hand-edited file may hold a bracket outside its range.
-    let w = match search(classify, &o) {
-        Ok(found) => found.into_row(row.mu, &o, String::new()),
-        Err(e) => {
-            return Relocated {
-                window_rpm: [from, to],
-                onset_rpm: None,
-                drops: 0,
-                note: format!("not searched again there: {e}"),
+    let (mut below, mut above) = (WINDOW_STEPS, WINDOW_STEPS);
+    let (from, to, w) = loop {
+        let from = (res * ((lo / res).floor() - below)).max(row.from_rpm);
+        let to = (res * ((hi / res).ceil() + above)).min(row.to_rpm);
+        let o = CriticalOptions {
+            from_rpm: from,
+            to_rpm: to,
+            resolution_rpm: res,
+            tol_rpm: row.tol_rpm,
+            duration_s: row.duration_s,
+        };
+        // A row read back from a hand-edited file may hold a bracket outside its range.
+        let w = match search(classify, &o) {
+            Ok(found) => found.into_row(row.mu, &o, String::new()),
+            Err(e) => {
+                return Relocated {
+                    window_rpm: [from, to],
+                    onset_rpm: None,
+                    drops: ran.load(Ordering::Relaxed),
+                    note: format!("not searched again there: {e}"),
+                }
             }
+        };
+        match (w.undecided, w.onset_rpm, w.bracket_rpm) {
+            (false, Some(_), None) if from > row.from_rpm && below < MAX_WINDOW_STEPS => {
+                below *= 2.0
+            }
+            (false, None, _) if to < row.to_rpm && above < MAX_WINDOW_STEPS => above *= 2.0,
+            _ => break (from, to, w),
         }
     };
     let (range_from, range_to) = (from <= row.from_rpm, to >= row.to_rpm);
@@ -178,7 +209,7 @@ fn relocate(
             None,
             format!(
                 "whirl there already at {} r/min, the window's lowest speed: its onset is there \
-                 or lower, two lattice steps or more below the bracket",
+                 or lower, sixteen lattice steps or more below the bracket",
                 fmt_rpm(from)
             ),
         ),
@@ -192,7 +223,8 @@ fn relocate(
         (false, None, _) => (
             None,
             format!(
-                "no whirl there up to {} r/min: its onset is higher, by more than two lattice steps",
+                "no whirl there up to {} r/min: its onset is higher, by more than sixteen lattice \
+                 steps",
                 fmt_rpm(to)
             ),
         ),
@@ -328,8 +360,26 @@ mod tests {
         );
     }
 
-    /// Whirl at the window's lowest speed, or none in it: no onset there, and the note says
-    /// which side and whether the window reached the range's end.
+    /// An onset beyond the first window is found by widening it, doubling its steps on that
+    /// side (here to sixteen, clipped at the range's lowest speed; and to sixteen above): the
+    /// whole-range search's, and no drop runs twice.
+    #[test]
+    fn a_wider_shift_is_found_by_widening_the_window() {
+        for (tighter_at, window) in [(2000.0, [1000.0, 5000.0]), (7000.0, [3750.0, 8500.0])] {
+            let (rc, ran) = recheck(4321.0, tighter_at, &[]);
+            let w = rc.relocated.unwrap();
+            assert_eq!(w.window_rpm, window);
+            assert_eq!(w.onset_rpm, row(tighter_at).onset_rpm);
+            let mut unique = ran.clone();
+            unique.sort_by(f64::total_cmp);
+            unique.dedup();
+            assert_eq!(unique.len(), ran.len(), "a drop ran twice: {ran:?}");
+            assert_eq!(w.drops, ran.len() - 2);
+        }
+    }
+
+    /// Whirl at the widest window's lowest speed, or none in it: no onset there, and the
+    /// note says which side and whether the window reached the range's end.
     #[test]
     fn an_onset_outside_the_window_is_named_by_its_side() {
         let note = |search_at: f64, tighter_at: f64| {
@@ -337,12 +387,16 @@ mod tests {
             assert_eq!(w.onset_rpm, None);
             w.note
         };
+        let n = note(8600.0, 2000.0);
         assert!(
-            note(4321.0, 2000.0).contains("the window's lowest speed: its onset is there or lower")
+            n.contains("at 4500 r/min, the window's lowest speed: its onset is there or lower"),
+            "{n}"
         );
         assert!(note(1300.0, 500.0).contains("at the range's lowest speed, 1000 r/min"));
+        let n = note(1300.0, 9500.0);
         assert!(
-            note(4321.0, 7000.0).contains("its onset is higher, by more than two lattice steps")
+            n.contains("up to 5500 r/min: its onset is higher, by more than sixteen"),
+            "{n}"
         );
         assert!(note(8600.0, 9500.0).contains("no whirl there from 8000 r/min to the range top"));
     }
