@@ -9,7 +9,8 @@
 //!   failed or unsettled drops leave undecided (`undecided` in `critical.json`) is an open circle, joined
 //!   to no neighbour; an onset the re-check at a tighter preset did not confirm (`recheck` in
 //!   `critical.json`, not `confirmed`) is an open square (an open circle when it is undecided
-//!   too), joined to no neighbour;
+//!   too), joined to no neighbour, with a dark diamond, joined by a dotted line, where the
+//!   tighter preset's window search put the onset (`recheck.relocated`);
 //! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
 //!   to the top of the searched range;
 //! - **no whirl in range** as an open triangle at the range top;
@@ -30,7 +31,7 @@ use whirlmap_results::critical::CriticalRow;
 use whirlmap_results::grid::clamp_value;
 
 use crate::axes::MU_DESC;
-use crate::marks::{arrow, legend, open_square, triangle_up, Mark, BAND};
+use crate::marks::{arrow, diamond, legend, open_square, triangle_up, Mark, BAND, CONTOUR};
 use crate::render::{
     draw_mesh, format_quantity, text_style, with_header, DrawResult, Figure, TITLE_BAND,
     TITLE_FONT, X_LABEL_AREA, Y_LABEL_AREA,
@@ -221,6 +222,8 @@ impl Figure for Fig4<'_> {
         let mut any_undecided = false;
         // The presets whose re-check did not confirm an onset, for the legend.
         let mut unconfirmed_at: Vec<&str> = Vec::new();
+        // The presets whose window search found an onset, for the legend.
+        let mut relocated_at: Vec<&str> = Vec::new();
         for (r, o) in rows.iter().zip(&onsets) {
             let Some((mu, s)) = o else { continue };
             let p = px(*mu, *s);
@@ -229,11 +232,29 @@ impl Figure for Fig4<'_> {
                 .as_ref()
                 .filter(|rc| !rc.confirmed && !r.undecided)
             {
-                // The tighter preset disagrees: an open square.
+                // The tighter preset disagrees: an open square, and where that preset puts
+                // the onset, when its window search found it: a diamond, joined by a dotted
+                // line.
                 if !unconfirmed_at.contains(&rc.fidelity.name()) {
                     unconfirmed_at.push(rc.fidelity.name());
                 }
+                let found = rc.relocated.as_ref().and_then(|w| w.onset_rpm);
+                if let Some(onset) = found {
+                    let q = px(*mu, clamp_value(onset));
+                    canvas.draw(&DashedPathElement::new(
+                        vec![p, q],
+                        3,
+                        3,
+                        CONTOUR.mix(0.7).stroke_width(1),
+                    ))?;
+                    if !relocated_at.contains(&rc.fidelity.name()) {
+                        relocated_at.push(rc.fidelity.name());
+                    }
+                }
                 open_square(&canvas, p, 6, BAND)?;
+                if let Some(onset) = found {
+                    diamond(&canvas, px(*mu, clamp_value(onset)), 6, CONTOUR)?;
+                }
             } else if r.undecided {
                 // Failed drops could move this onset: an open circle.
                 any_undecided = true;
@@ -333,6 +354,15 @@ impl Figure for Fig4<'_> {
                 format!(
                     "onset not confirmed by the re-check at {}",
                     unconfirmed_at.join(", ")
+                ),
+            ));
+        }
+        if !relocated_at.is_empty() {
+            entries.push((
+                Mark::Diamond(CONTOUR),
+                format!(
+                    "onset at {}, searched again near the bracket",
+                    relocated_at.join(", ")
                 ),
             ));
         }
@@ -463,7 +493,7 @@ mod tests {
     fn an_unconfirmed_onset_is_not_joined_and_is_drawn_apart() {
         use whirlmap_core::classify::OrbitClass;
         use whirlmap_core::Fidelity;
-        use whirlmap_results::critical::{Outcome, Recheck};
+        use whirlmap_results::critical::{Outcome, Recheck, Relocated};
         let (rows, i) = paper_rows_at_mu_0_4();
         let [lo, hi] = rows[i].bracket_rpm.expect("a bracket");
         let recheck = |confirmed: bool| Recheck {
@@ -514,6 +544,17 @@ mod tests {
         let drawn = draw(&unconfirmed, "unconfirmed");
         assert_ne!(drawn, plain);
         assert_ne!(drawn, draw(&undecided, "undecided"));
+        // Where the tighter preset's window search put the onset, 500 r/min lower: a diamond
+        // joined to the square (and its legend entry).
+        let mut relocated = unconfirmed.clone();
+        let rc = relocated[i].recheck.as_mut().unwrap();
+        rc.relocated = Some(Relocated {
+            window_rpm: [lo - 1000.0, hi + 500.0],
+            onset_rpm: Some(lo - 500.0),
+            drops: 10,
+            note: String::new(),
+        });
+        assert_ne!(draw(&relocated, "relocated"), drawn);
     }
 
     #[test]

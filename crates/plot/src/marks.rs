@@ -74,6 +74,8 @@ pub enum Mark {
     OpenDot(RGBColor),
     /// An open square ([`open_square`]).
     OpenSquare(RGBColor),
+    /// A filled diamond ([`diamond`]).
+    Diamond(RGBColor),
     /// Where a drop was, on a grid of uneven cells ([`drop_dot`]).
     Drop,
 }
@@ -275,6 +277,7 @@ pub(crate) fn draw_mark<DB: DrawingBackend>(
             area.draw(&Circle::new((x + mark_w / 2, y), 5, c.stroke_width(2)))?;
         }
         Mark::OpenSquare(c) => open_square(area, (x + mark_w / 2, y), 5, c)?,
+        Mark::Diamond(c) => diamond(area, (x + mark_w / 2, y), 6, c)?,
         Mark::Fill(c) => {
             area.draw(&Rectangle::new(
                 [(bx0, by0), (bx1, by1)],
@@ -296,6 +299,18 @@ pub(crate) fn open_square<DB: DrawingBackend>(
     let corners = [(x - r, y - r), (x + r, y + r)];
     area.draw(&Rectangle::new(corners, WHITE.filled()))?;
     area.draw(&Rectangle::new(corners, colour.stroke_width(2)))
+}
+
+/// A filled diamond of half-diagonal `r` centred at pixel `p`, ringed in white.
+pub(crate) fn diamond<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x, y): (i32, i32),
+    r: i32,
+    colour: RGBColor,
+) -> DrawResult<DB> {
+    let pts = vec![(x, y - r), (x + r, y), (x, y + r), (x - r, y), (x, y - r)];
+    area.draw(&Polygon::new(pts.clone(), colour.filled()))?;
+    area.draw(&PathElement::new(pts, WHITE.stroke_width(1)))
 }
 
 /// Draws `text` with a white box behind it, centred at pixel `(x, y)` of `area`.
