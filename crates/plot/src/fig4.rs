@@ -238,9 +238,10 @@ impl Figure for Fig4<'_> {
                 if !unconfirmed_at.contains(&rc.fidelity.name()) {
                     unconfirmed_at.push(rc.fidelity.name());
                 }
-                let found = rc.relocated.as_ref().and_then(|w| w.onset_rpm);
-                if let Some(onset) = found {
-                    let q = px(*mu, clamp_value(onset));
+                let found = (rc.relocated.as_ref())
+                    .and_then(|w| w.onset_rpm)
+                    .map(|onset| px(*mu, clamp_value(onset)));
+                if let Some(q) = found {
                     canvas.draw(&DashedPathElement::new(
                         vec![p, q],
                         3,
@@ -252,8 +253,8 @@ impl Figure for Fig4<'_> {
                     }
                 }
                 open_square(&canvas, p, 6, BAND)?;
-                if let Some(onset) = found {
-                    diamond(&canvas, px(*mu, clamp_value(onset)), 6, CONTOUR)?;
+                if let Some(q) = found {
+                    diamond(&canvas, q, 6, CONTOUR)?;
                 }
             } else if r.undecided {
                 // Failed drops could move this onset: an open circle.
@@ -434,6 +435,27 @@ mod tests {
         }
     }
 
+    /// The PNG bytes of Fig. 4 drawn from `rows` with `title`, through a temp file named by
+    /// `tag`, kept (and named on standard error) when `WHIRLMAP_KEEP_CHART` is set, to be
+    /// looked at.
+    fn drawn(rows: &[CriticalRow], tag: &str, title: &str) -> Vec<u8> {
+        let path =
+            std::env::temp_dir().join(format!("whirlmap-fig4-{tag}-{}.png", std::process::id()));
+        let fig = Fig4 {
+            rows,
+            band: None,
+            title: title.into(),
+        };
+        crate::render::render(&path, (1000, 700), &fig).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        if std::env::var_os("WHIRLMAP_KEEP_CHART").is_some() {
+            eprintln!("chart: {}", path.display());
+        } else {
+            std::fs::remove_file(&path).ok();
+        }
+        bytes
+    }
+
     /// The main job's committed critical rows in order of mu, and the index of mu 0.4 (an
     /// onset joined to both neighbours).
     fn paper_rows_at_mu_0_4() -> (Vec<CriticalRow>, usize) {
@@ -462,24 +484,8 @@ mod tests {
         assert!(joined(&rows[i + 1], &rows[i + 2]), "the others stay joined");
 
         let pixels = |rows: &[CriticalRow]| {
-            let path = std::env::temp_dir().join(format!(
-                "whirlmap-fig4-undecided-{}-{}.png",
-                std::process::id(),
-                rows.iter().filter(|r| r.undecided).count()
-            ));
-            let fig = Fig4 {
-                rows,
-                band: None,
-                title: "Fig. 4 with an undecided onset".into(),
-            };
-            crate::render::render(&path, (1000, 700), &fig).unwrap();
-            let bytes = std::fs::read(&path).unwrap();
-            if std::env::var_os("WHIRLMAP_KEEP_CHART").is_some() {
-                eprintln!("chart: {}", path.display());
-            } else {
-                std::fs::remove_file(&path).ok();
-            }
-            bytes
+            let tag = format!("undecided-{}", rows.iter().filter(|r| r.undecided).count());
+            drawn(rows, &tag, "Fig. 4 with an undecided onset")
         };
         let mut decided = rows.clone();
         decided[i].undecided = false;
@@ -504,23 +510,11 @@ mod tests {
             relocated: None,
         };
         let draw = |rows: &[CriticalRow], tag: &str| {
-            let path = std::env::temp_dir().join(format!(
-                "whirlmap-fig4-recheck-{}-{tag}.png",
-                std::process::id()
-            ));
-            let fig = Fig4 {
+            drawn(
                 rows,
-                band: None,
-                title: "Fig. 4 with an unconfirmed onset".into(),
-            };
-            crate::render::render(&path, (1000, 700), &fig).unwrap();
-            let bytes = std::fs::read(&path).unwrap();
-            if std::env::var_os("WHIRLMAP_KEEP_CHART").is_some() {
-                eprintln!("chart: {}", path.display());
-            } else {
-                std::fs::remove_file(&path).ok();
-            }
-            bytes
+                &format!("recheck-{tag}"),
+                "Fig. 4 with an unconfirmed onset",
+            )
         };
         let plain = draw(&rows, "plain");
         let mut confirmed = rows.clone();
