@@ -19,6 +19,9 @@ use std::ops::ControlFlow;
 /// Version of the model and its outputs; part of every record key. Bump it when a change
 /// alters results for the same scene.
 ///
+/// - 11: the model's fractional powers (the contact's Hertz law, eq. 7, and Palmgren's drag,
+///   eqs. 12-13) come from the model's own `pow` (`model/pow.rs`, within 1e-14 of libm's),
+///   which cut one right-hand-side evaluation by a quarter; results move in their last digits.
 /// - 10: the event loop watches a guard that starts a step at exactly zero and locates its
 ///   going below zero, and a guard at zero when a step starts that is below zero at another
 ///   guard's event takes its own switch there (before, a guard was watched only once
@@ -51,7 +54,7 @@ use std::ops::ControlFlow;
 ///   classes describe the settled motion on a final window, undecided runs are extended,
 ///   and the whirl rule counts consecutive carried turns ([`crate::classify`]).
 /// - 2: a slip entered against the drifted slip velocity takes its sign.
-pub const MODEL_VERSION: u32 = 10;
+pub const MODEL_VERSION: u32 = 11;
 
 /// Largest first step after a mode switch (s): see [`Stepper::cap_next_step`].
 pub(crate) const STEP_AFTER_SWITCH_S: f64 = 1e-7;

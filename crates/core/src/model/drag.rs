@@ -2,6 +2,8 @@
 //! when a thermal load is added later). Catalogue units are converted here and only here:
 //! M in N mm, d_m in mm, nu0 in mm^2/s, n in r/min, P1 and C0 in N.
 
+use super::pow::pow;
+
 /// Palmgren parameters in catalogue units, prepared once from a scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Palmgren {
@@ -34,8 +36,8 @@ impl Palmgren {
     #[inline]
     fn nu0_n_pow_2_3(&self, omega_rad_s: f64) -> f64 {
         let x = self.nu0_mm2_s * omega_rad_s.abs() * RAD_S_TO_RPM;
-        // powf rather than cbrt: Rust's cbrt is a slow software routine (see hertz.rs).
-        x.powf(2.0 / 3.0)
+        // The model's own power (model/pow.rs), not libm's pow or cbrt.
+        pow(x, 2.0 / 3.0)
     }
 
     /// M_0 (N m) of eq. 12 from `(nu0 n)^(2/3)`.
@@ -53,7 +55,7 @@ impl Palmgren {
         if p == 0.0 {
             return 0.0;
         }
-        let f1 = 0.001 * (p / self.c0_n).powf(0.33);
+        let f1 = 0.001 * pow(p / self.c0_n, 0.33);
         f1 * p * self.dm_mm * 1e-3
     }
 
@@ -135,15 +137,15 @@ mod tests {
                 let (m, dw, dl) = b.torque_and_slopes(omega, load);
                 // The bits of the formulas as written before the powers were shared.
                 let x = b.nu0_mm2_s * f64::abs(omega) * RAD_S_TO_RPM;
-                let m0 = 1e-7 * b.f0 * x.powf(2.0 / 3.0).max(160.0) * b.dm_mm.powi(3) * 1e-3;
+                let m0 = 1e-7 * b.f0 * pow(x, 2.0 / 3.0).max(160.0) * b.dm_mm.powi(3) * 1e-3;
                 let p = f64::max(load, 0.0);
                 let m1 = if p == 0.0 {
                     0.0
                 } else {
-                    0.001 * (p / b.c0_n).powf(0.33) * p * b.dm_mm * 1e-3
+                    0.001 * pow(p / b.c0_n, 0.33) * p * b.dm_mm * 1e-3
                 };
                 assert_eq!(m.to_bits(), (m0 + m1).to_bits());
-                let old_dw = if omega != 0.0 && x.powf(2.0 / 3.0) > 160.0 {
+                let old_dw = if omega != 0.0 && pow(x, 2.0 / 3.0) > 160.0 {
                     (2.0 / 3.0) * m0 / omega
                 } else {
                     0.0
