@@ -643,6 +643,17 @@ pub fn search<F: Fn(f64) -> Outcome + Sync>(
     Ok(v.remove(0))
 }
 
+/// [`search`], telling `expect` how many bisection drops its scan has made due (see
+/// [`search_all_expecting`]).
+pub fn search_expecting<F: Fn(f64) -> Outcome + Sync>(
+    classify_at: F,
+    o: &CriticalOptions,
+    expect: &(dyn Fn(usize) + Sync),
+) -> Result<SearchResult, InvalidParameter> {
+    let mut v = search_all_expecting(|_, s| classify_at(s), 1, o, expect)?;
+    Ok(v.remove(0))
+}
+
 /// Classifies one drop of `scene` at `speed_rpm`: its class, or its failure (a solver error,
 /// or a panic inside the solver, caught so one bad drop cannot take a search down).
 pub fn drop_outcome(scene: &Scene, speed_rpm: f64, opts: &DropOptions) -> Outcome {

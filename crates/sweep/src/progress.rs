@@ -90,6 +90,24 @@ impl Ticker {
         }
     }
 
+    /// `n` of the drops expected will not run after all (answered from memory), though never
+    /// fewer than are done.
+    pub fn expect_fewer(&self, n: usize) {
+        let done = self.done.load(Ordering::Relaxed);
+        let update = |e: usize| Some(e.saturating_sub(n).max(done));
+        let old = (self.expected)
+            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, update)
+            .expect("the update always gives a value");
+        if let Some(b) = &self.bar {
+            b.set_length(update(old).unwrap_or(old) as u64);
+        }
+    }
+
+    /// Drops expected so far.
+    pub fn expected(&self) -> usize {
+        self.expected.load(Ordering::Relaxed)
+    }
+
     /// One drop is done.
     pub fn tick(&self) {
         let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -144,5 +162,17 @@ mod tests {
         }
         assert_eq!(t.done(), 3);
         assert!(t.line().contains("3 of 3 drops"), "{}", t.line());
+    }
+
+    #[test]
+    fn drops_answered_from_memory_leave_the_total_but_never_below_the_count() {
+        let t = Ticker::off();
+        t.expect_more(5);
+        t.tick();
+        t.expect_fewer(2);
+        assert_eq!(t.expected(), 3);
+        t.expect_fewer(9);
+        assert_eq!(t.expected(), 1, "not below the one done");
+        assert!(t.line().contains("1 of 1 drops"), "{}", t.line());
     }
 }

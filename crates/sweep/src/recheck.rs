@@ -8,7 +8,9 @@
 //! searched; up to sixteen), to say where that preset puts the onset ([`Relocated`]).
 
 use crate::cancel::Cancel;
-use crate::critical::{drop_outcome, fmt_rpm, search, CriticalOptions, CriticalRow, Outcome};
+use crate::critical::{
+    drop_outcome, fmt_rpm, search_expecting, CriticalOptions, CriticalRow, Outcome,
+};
 use crate::progress::Ticker;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -27,9 +29,13 @@ pub fn recheck_bracket(
     tighter: Fidelity,
     opts: &DropOptions,
 ) -> Option<Recheck> {
-    recheck_with(scene, row, tighter, &|s, speed| {
-        drop_outcome(s, speed, opts)
-    })
+    recheck_with(
+        scene,
+        row,
+        tighter,
+        &|s, speed| drop_outcome(s, speed, opts),
+        None,
+    )
 }
 
 /// Re-checks every row's bracket ([`recheck_bracket`]) at `tighter`, the rows at once, each
@@ -37,7 +43,7 @@ pub fn recheck_bracket(
 /// ([`Recheck::apply_to`]: an unconfirmed bracket leaves the row not converged). With `cancel`, a drop not yet started
 /// when it is raised is skipped (its outcome "cancelled"; the caller discards the rows)
 /// and every drop run is counted on it. Every drop run ticks `ticker`, which expects the
-/// brackets' two drops each (a window search's come on top).
+/// brackets' two drops each, and a window search's as it plans them.
 pub fn recheck_rows(
     base: &Scene,
     rows: &mut [CriticalRow],
@@ -67,17 +73,20 @@ pub fn recheck_rows(
     rows.par_iter_mut().for_each(|row| {
         let mut s = base.clone();
         s.mu_dynamic = row.mu;
-        if let Some(rc) = recheck_with(&s, row, tighter, &run) {
+        if let Some(rc) = recheck_with(&s, row, tighter, &run, ticker) {
             rc.apply_to(row);
         }
     });
 }
 
+/// The re-check of [`recheck_bracket`] with `run` for a drop. `ticker`, whose count `run`
+/// ticks, is told of a window search's drops as they are planned.
 fn recheck_with(
     scene: &Scene,
     row: &CriticalRow,
     tighter: Fidelity,
     run: &(dyn Fn(&Scene, f64) -> Outcome + Sync),
+    ticker: Option<&Ticker>,
 ) -> Option<Recheck> {
     let [lo, hi] = row.bracket_rpm?;
     let s = tighter.applied(scene);
@@ -87,7 +96,8 @@ fn recheck_with(
     let settled_below =
         matches!(&out_lo, Outcome::Class(c) if !c.is_whirl() && *c != OrbitClass::Unresolved);
     let confirmed = settled_below && out_hi.whirl() == Some(true);
-    let relocated = (!confirmed).then(|| relocate(&s, row, [(lo, &out_lo), (hi, &out_hi)], run));
+    let relocated =
+        (!confirmed).then(|| relocate(&s, row, [(lo, &out_lo), (hi, &out_hi)], run, ticker));
     Some(Recheck {
         fidelity: tighter,
         lo: (lo, out_lo),
@@ -113,12 +123,14 @@ const MAX_WINDOW_STEPS: f64 = 16.0;
 /// scan drops are the ones a search of the whole range drops there, and it finds the onset
 /// that search would, when that onset is in the window above its lower end. No drop runs
 /// twice: the bracket's two at the tighter preset (`known`) and every drop of a narrower
-/// window are answered from memory.
+/// window are answered from memory. `ticker` expects each window's scan and bisections as
+/// they are planned, less those answered from memory.
 fn relocate(
     tighter_scene: &Scene,
     row: &CriticalRow,
     known: [(f64, &Outcome); 2],
     run: &(dyn Fn(&Scene, f64) -> Outcome + Sync),
+    ticker: Option<&Ticker>,
 ) -> Relocated {
     let [(lo, _), (hi, _)] = known;
     let res = row.resolution_rpm;
@@ -136,6 +148,9 @@ fn relocate(
             .expect("no panic holds it")
             .get(&speed.to_bits())
         {
+            if let Some(t) = ticker {
+                t.expect_fewer(1);
+            }
             return o.clone();
         }
         ran.fetch_add(1, Ordering::Relaxed);
@@ -156,8 +171,16 @@ fn relocate(
             tol_rpm: row.tol_rpm,
             duration_s: row.duration_s,
         };
+        if let (Some(t), Ok(())) = (ticker, o.validate()) {
+            t.expect_more(o.scan_speeds().len());
+        }
+        let expect = |n| {
+            if let Some(t) = ticker {
+                t.expect_more(n)
+            }
+        };
         // A row read back from a hand-edited file may hold a bracket outside its range.
-        let w = match search(classify, &o) {
+        let w = match search_expecting(classify, &o, &expect) {
             Ok(found) => found.into_row(row.mu, &o, String::new()),
             Err(e) => {
                 return Relocated {
@@ -274,20 +297,45 @@ mod tests {
 
     /// The re-check of the row searched with whirl from `search_at`, at a "tighter preset"
     /// with whirl from `tighter_at` (`fails` lists speeds whose drop fails there), and the
-    /// speeds it ran.
+    /// speeds it ran. Its progress ticker, expecting the bracket's two drops as
+    /// [`recheck_rows`] does, expects every drop before it runs, and ends with every drop it
+    /// expected run (a failed one may add bisection drops, so not with `fails`).
     fn recheck(search_at: f64, tighter_at: f64, fails: &[f64]) -> (Recheck, Vec<f64>) {
         let ran = Mutex::new(Vec::new());
+        let unexpected = Mutex::new(Vec::<f64>::new());
+        let ticker = Ticker::off();
+        ticker.expect_more(2);
         let run = |_: &Scene, speed: f64| {
             ran.lock().unwrap().push(speed);
+            if ticker.expected() <= ticker.done() {
+                unexpected.lock().unwrap().push(speed);
+            }
+            ticker.tick();
             if fails.contains(&speed) {
                 Outcome::Failed("step_budget: x".into())
             } else {
                 class_at(tighter_at, speed)
             }
         };
-        let rc = recheck_with(&Scene::paper(), &row(search_at), Fidelity::Standard, &run)
-            .expect("a bracket");
-        (rc, ran.into_inner().unwrap())
+        let rc = recheck_with(
+            &Scene::paper(),
+            &row(search_at),
+            Fidelity::Standard,
+            &run,
+            Some(&ticker),
+        )
+        .expect("a bracket");
+        let ran = ran.into_inner().unwrap();
+        assert_eq!(ticker.done(), ran.len());
+        if fails.is_empty() {
+            assert_eq!(
+                unexpected.into_inner().unwrap(),
+                [0.0; 0],
+                "drops not expected"
+            );
+            assert_eq!(ticker.expected(), ran.len(), "the progress total");
+        }
+        (rc, ran)
     }
 
     #[test]
@@ -349,10 +397,20 @@ mod tests {
     fn a_bracket_outside_its_range_gives_a_note() {
         let mut r = row(4321.0);
         r.from_rpm = 5000.0;
-        let run = |_: &Scene, speed: f64| class_at(4100.0, speed);
-        let rc = recheck_with(&Scene::paper(), &r, Fidelity::Standard, &run).unwrap();
-        let w = rc.relocated.unwrap();
+        let ticker = Ticker::off();
+        ticker.expect_more(2);
+        let run = |_: &Scene, speed: f64| {
+            ticker.tick();
+            class_at(4100.0, speed)
+        };
+        let rc = recheck_with(&Scene::paper(), &r, Fidelity::Standard, &run, Some(&ticker));
+        let w = rc.unwrap().relocated.unwrap();
         assert_eq!((w.onset_rpm, w.drops), (None, 0));
+        assert_eq!(
+            (ticker.done(), ticker.expected()),
+            (2, 2),
+            "no window planned"
+        );
         assert!(
             w.note.starts_with("not searched again there: "),
             "{}",
