@@ -14,6 +14,9 @@ cd "$(dirname "$0")/.."
 # target folder (1.1 GB in all without it).
 export CARGO_INCREMENTAL=0
 
+echo "== the power function's tables are the generator's"
+"${PYTHON:-python3}" scripts/gen-pow-tables.py | diff - crates/core/src/model/pow_tables.rs
+
 echo "== cargo test --workspace"
 cargo test --workspace
 

@@ -18,7 +18,7 @@ pub mod hertz;
 mod jacobian;
 mod memo;
 pub mod modes;
-pub mod pow;
+mod pow;
 mod pow_tables;
 pub mod quasi_static;
 mod state;
