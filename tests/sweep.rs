@@ -765,6 +765,65 @@ fn a_sweep_rechecks_its_critical_brackets_when_asked() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A sweep whose re-check does not confirm an onset keeps saying so: `--resume` of the
+/// finished folder keeps its point and `critical.json` byte for byte and exits 1 with the
+/// same message; sharded (shard 0 owns mu 0.25, the unconfirmed one), the shard that
+/// holds the row exits 1, and the merge exits 1 and writes the single run's `critical.json`.
+#[test]
+fn a_rechecked_sweep_resumes_and_merges_with_its_unconfirmed_row() {
+    let dir = temp_dir("recheck-resume-merge");
+    let spec = spec_file(
+        &dir,
+        "rc.json",
+        r#"{"name": "rc", "duration_s": 1.0, "fidelity": "draft",
+            "axes": {"speed_rpm": [4000], "mu": [0.3]},
+            "critical": {"mu": [0.25, 0.35], "speed_rpm": {"from": 2000, "to": 16000},
+              "resolution_rpm": 1000, "tol_rpm": 100, "recheck": true}}"#,
+    );
+    let message = "does not confirm the onset at mu 0.25 (at standard:";
+    let single = dir.join("single");
+    let o = whirlmap(&["sweep", s(&spec), "--out", s(&single), "--no-progress"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let rows = std::fs::read(single.join("critical.json")).unwrap();
+
+    let o = whirlmap(&[
+        "sweep",
+        s(&spec),
+        "--out",
+        s(&single),
+        "--resume",
+        "--no-progress",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains(message), "{}", stderr(&o));
+    assert!(out(&o).contains("(1 resumed)"), "{}", out(&o));
+    assert_eq!(std::fs::read(single.join("critical.json")).unwrap(), rows);
+
+    let mut shards = Vec::new();
+    for (i, code) in [(0, 1), (1, 0)] {
+        let d = dir.join(format!("shard-{i}"));
+        let o = whirlmap(&[
+            "sweep",
+            s(&spec),
+            "--shard",
+            &i.to_string(),
+            "--shards",
+            "2",
+            "--out",
+            s(&d),
+            "--no-progress",
+        ]);
+        assert_eq!(o.status.code(), Some(code), "shard {i}: {}", stderr(&o));
+        shards.push(d);
+    }
+    let merged = dir.join("merged");
+    let o = whirlmap(&["merge", s(&shards[0]), s(&shards[1]), "--out", s(&merged)]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains(message), "{}", stderr(&o));
+    assert_eq!(std::fs::read(merged.join("critical.json")).unwrap(), rows);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 const CRITICAL_SPEC: &str = r#"{"name": "crit", "duration_s": 0.1,
     "scene": {"solver": {"rtol": 1e-7}},
     "axes": {"speed_rpm": [4000], "mu": [0.3]},
