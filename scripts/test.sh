@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Every test of the repository: the Rust workspace, then the Python package built from the
-# same crates (installed into a fresh virtual environment with the README's pip command).
+# Every test of the repository: a check that the power function's tables are their
+# generator's, the Rust workspace, then the Python package built from the same crates
+# (installed into a fresh virtual environment with the README's pip command).
 # Needs Rust and a CPython >= 3.9 with venv; PyPI and crates.io must be reachable.
 #
 #   bash scripts/test.sh

@@ -20,8 +20,9 @@ use std::ops::ControlFlow;
 /// alters results for the same scene.
 ///
 /// - 11: the model's fractional powers (the contact's Hertz law, eq. 7, and Palmgren's drag,
-///   eqs. 12-13) come from the model's own `pow` (`model/pow.rs`, within 1e-14 of libm's),
-///   which cut one right-hand-side evaluation by a quarter; results move in their last digits.
+///   eqs. 12-13) come from the model's own `pow` (`model/pow.rs`, within 1.1e-14 of the exact
+///   powers over the model's usual arguments), which cut one right-hand-side evaluation by a
+///   quarter; results move in their last digits.
 /// - 10: the event loop watches a guard that starts a step at exactly zero and locates its
 ///   going below zero, and a guard at zero when a step starts that is below zero at another
 ///   guard's event takes its own switch there (before, a guard was watched only once

@@ -639,8 +639,7 @@ pub fn search<F: Fn(f64) -> Outcome + Sync>(
     classify_at: F,
     o: &CriticalOptions,
 ) -> Result<SearchResult, InvalidParameter> {
-    let mut v = search_all(|_, s| classify_at(s), 1, o)?;
-    Ok(v.remove(0))
+    search_expecting(classify_at, o, &|_| {})
 }
 
 /// [`search`], telling `expect` how many bisection drops its scan has made due (see
