@@ -490,17 +490,7 @@ fn a_sweep_shard_and_merge_exit_1_when_a_critical_speed_is_undecided() {
     let mut shards = Vec::new();
     for (i, code) in [(0, 1), (1, 0)] {
         let d = dir.join(format!("shard-{i}"));
-        let o = whirlmap(&[
-            "sweep",
-            s(&spec),
-            "--shard",
-            &i.to_string(),
-            "--shards",
-            "2",
-            "--out",
-            s(&d),
-            "--no-progress",
-        ]);
+        let o = sweep_shard(&spec, &d, i, 2);
         assert_eq!(o.status.code(), Some(code), "shard {i}: {}", out(&o));
         shards.push(d);
     }

@@ -786,17 +786,7 @@ fn results_record_the_binarys_build_and_merge_refuses_two_builds() {
     let shards: Vec<PathBuf> = (0..2)
         .map(|i| {
             let d = dir.join(format!("shard-{i}"));
-            let o = whirlmap(&[
-                "sweep",
-                s(&spec),
-                "--shard",
-                &i.to_string(),
-                "--shards",
-                "2",
-                "--out",
-                s(&d),
-                "--no-progress",
-            ]);
+            let o = sweep_shard(&spec, &d, i, 2);
             assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
             assert_eq!(
                 read_json(&d.join("shard.json"))["git_commit"],

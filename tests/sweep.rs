@@ -802,17 +802,7 @@ fn a_rechecked_sweep_resumes_and_merges_with_its_unconfirmed_row() {
     let mut shards = Vec::new();
     for (i, code) in [(0, 1), (1, 0)] {
         let d = dir.join(format!("shard-{i}"));
-        let o = whirlmap(&[
-            "sweep",
-            s(&spec),
-            "--shard",
-            &i.to_string(),
-            "--shards",
-            "2",
-            "--out",
-            s(&d),
-            "--no-progress",
-        ]);
+        let o = sweep_shard(&spec, &d, i, 2);
         assert_eq!(o.status.code(), Some(code), "shard {i}: {}", stderr(&o));
         shards.push(d);
     }

@@ -108,6 +108,22 @@ pub fn kill_after_lines<S: AsRef<OsStr>>(args: &[S], file: &Path, lines: usize) 
     }
 }
 
+/// Runs shard `i` of `n` of the sweep `spec` into `out`, without progress output.
+pub fn sweep_shard(spec: &Path, out: &Path, i: usize, n: usize) -> Output {
+    let (i, n) = (i.to_string(), n.to_string());
+    whirlmap(&[
+        "sweep",
+        s(spec),
+        "--shard",
+        &i,
+        "--shards",
+        &n,
+        "--out",
+        s(out),
+        "--no-progress",
+    ])
+}
+
 /// Writes a sweep spec `text` to `dir/<name>.json` and returns its path.
 pub fn spec_file(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(format!("{name}.json"));
