@@ -682,6 +682,14 @@ fn a_resumed_sweep_keeps_the_finished_critical_search_and_orbits() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A `draft` sweep whose critical search re-checks its brackets at `standard`: the bracket of
+/// mu 0.25 is not confirmed there, that of mu 0.35 is (tests/critical.rs).
+const RECHECK_SPEC: &str = r#"{"name": "rc", "duration_s": 1.0, "fidelity": "draft",
+    "axes": {"speed_rpm": [4000], "mu": [0.3]},
+    "critical": {"mu": [0.25, 0.35], "speed_rpm": {"from": 2000, "to": 16000},
+      "resolution_rpm": 1000, "tol_rpm": 100, "recheck": true},
+    "charts": ["critical"]}"#;
+
 /// With `critical.recheck`, a sweep re-checks each onset bracket at the next tighter preset
 /// as `whirlmap critical --fidelity` does: its rows are the command's, a bracket the tighter
 /// preset does not confirm (mu 0.25 at `draft`, see tests/critical.rs) leaves its row not
@@ -689,15 +697,7 @@ fn a_resumed_sweep_keeps_the_finished_critical_search_and_orbits() {
 #[test]
 fn a_sweep_rechecks_its_critical_brackets_when_asked() {
     let dir = temp_dir("recheck");
-    let spec = spec_file(
-        &dir,
-        "rc.json",
-        r#"{"name": "rc", "duration_s": 1.0, "fidelity": "draft",
-            "axes": {"speed_rpm": [4000], "mu": [0.3]},
-            "critical": {"mu": [0.25, 0.35], "speed_rpm": {"from": 2000, "to": 16000},
-              "resolution_rpm": 1000, "tol_rpm": 100, "recheck": true},
-            "charts": ["critical"]}"#,
-    );
+    let spec = spec_file(&dir, "rc", RECHECK_SPEC);
     let out_dir = dir.join("out");
     let o = whirlmap(&["sweep", s(&spec), "--out", s(&out_dir), "--no-progress"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
@@ -772,14 +772,7 @@ fn a_sweep_rechecks_its_critical_brackets_when_asked() {
 #[test]
 fn a_rechecked_sweep_resumes_and_merges_with_its_unconfirmed_row() {
     let dir = temp_dir("recheck-resume-merge");
-    let spec = spec_file(
-        &dir,
-        "rc.json",
-        r#"{"name": "rc", "duration_s": 1.0, "fidelity": "draft",
-            "axes": {"speed_rpm": [4000], "mu": [0.3]},
-            "critical": {"mu": [0.25, 0.35], "speed_rpm": {"from": 2000, "to": 16000},
-              "resolution_rpm": 1000, "tol_rpm": 100, "recheck": true}}"#,
-    );
+    let spec = spec_file(&dir, "rc", RECHECK_SPEC);
     let message = "does not confirm the onset at mu 0.25 (at standard:";
     let single = dir.join("single");
     let o = whirlmap(&["sweep", s(&spec), "--out", s(&single), "--no-progress"]);
