@@ -44,22 +44,7 @@ fn full_run(spec: &Path, out: &Path) {
 }
 
 fn run_shard(spec: &Path, out: &Path, i: usize, n: usize, extra: &[&str]) -> Output {
-    let (i, n) = (i.to_string(), n.to_string());
-    let mut args = vec![
-        "sweep",
-        s(spec),
-        "--shard",
-        &i,
-        "--shards",
-        &n,
-        "--out",
-        s(out),
-        "--threads",
-        "1",
-        "--no-progress",
-    ];
-    args.extend_from_slice(extra);
-    whirlmap(&args)
+    sweep_shard_with(spec, out, i, n, &[&["--threads", "1"], extra].concat())
 }
 
 /// Runs every shard of `n` into `dir/shard-I` and returns the folders.

@@ -110,8 +110,13 @@ pub fn kill_after_lines<S: AsRef<OsStr>>(args: &[S], file: &Path, lines: usize) 
 
 /// Runs shard `i` of `n` of the sweep `spec` into `out`, without progress output.
 pub fn sweep_shard(spec: &Path, out: &Path, i: usize, n: usize) -> Output {
+    sweep_shard_with(spec, out, i, n, &[])
+}
+
+/// [`sweep_shard`] with `extra` arguments after the others.
+pub fn sweep_shard_with(spec: &Path, out: &Path, i: usize, n: usize, extra: &[&str]) -> Output {
     let (i, n) = (i.to_string(), n.to_string());
-    whirlmap(&[
+    let mut args = vec![
         "sweep",
         s(spec),
         "--shard",
@@ -121,7 +126,9 @@ pub fn sweep_shard(spec: &Path, out: &Path, i: usize, n: usize) -> Output {
         "--out",
         s(out),
         "--no-progress",
-    ])
+    ];
+    args.extend_from_slice(extra);
+    whirlmap(&args)
 }
 
 /// Writes a sweep spec `text` to `dir/<name>.json` and returns its path.

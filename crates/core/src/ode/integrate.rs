@@ -55,6 +55,16 @@ pub enum Stop<G, H> {
     Halted(H),
 }
 
+/// Whether a guard that starts a step at `g0` has crossed at a later value `v`: from above
+/// zero to `<= 0`, or from exactly zero to `< 0` (never from below zero).
+fn crosses_from(g0: f64, v: f64) -> bool {
+    if g0 == 0.0 {
+        v < 0.0
+    } else {
+        g0 > 0.0 && v <= 0.0
+    }
+}
+
 /// Integrates `sys` from `(t, y)` towards `t_end`, advancing `t` and `y` in place.
 ///
 /// The step stops exactly at `t_end`, at a located guard crossing, or where an observer
@@ -106,7 +116,7 @@ where
             // A guard at zero is located as if zero were above it: `crosses` is the side
             // the crossing reaches, `lifted` the guard with zero counted on the near side.
             let from_zero = g0[i] == 0.0;
-            let crosses = |v: f64| if from_zero { v < 0.0 } else { v <= 0.0 };
+            let crosses = |v: f64| crosses_from(g0[i], v);
             let lifted = |v: f64| {
                 if from_zero && v >= 0.0 {
                     f64::MIN_POSITIVE
@@ -139,9 +149,7 @@ where
                 let mut crossed = [false; MAX_GUARDS];
                 let mut violated_before = [false; MAX_GUARDS];
                 for j in 0..ng {
-                    crossed[j] = j != index
-                        && ((g0[j] > 0.0 && at_event[j] <= 0.0)
-                            || (g0[j] == 0.0 && at_event[j] < 0.0));
+                    crossed[j] = j != index && crosses_from(g0[j], at_event[j]);
                     violated_before[j] = g0[j] < 0.0 && at_event[j] <= 0.0;
                 }
                 let view = StepView { dense: cut };
