@@ -184,7 +184,8 @@ enum Command {
 
 #[derive(clap::Args)]
 struct DropArgs {
-    /// Rotor speed at release (r/min); default: the scene's (8000).
+    /// Rotor speed at release (r/min), in [-1e6, 1e6] (negative: spinning the other way);
+    /// default: the scene's (8000).
     #[arg(long, allow_negative_numbers = true)]
     speed_rpm: Option<f64>,
     /// Dynamic friction coefficient rotor-race, [0, 2]; default: the scene's (0.1).

@@ -129,11 +129,17 @@ fn finite_range(scene: &Scene, key: &str) -> String {
 /// Sets the scene parameter `key` (dotted for nested fields) to `value`.
 pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideError> {
     let mut root = serde_json::to_value(&*scene).expect("a scene serialises");
+    let before = get_value(&root, key).cloned();
+    let shown = match &value {
+        Value::String(text) => text.clone(),
+        other => other.to_string(),
+    };
     set_value(&mut root, key, value)?;
     let parsed: Scene =
         serde_json::from_value(root.clone()).map_err(|e| OverrideError::BadValue {
             key: key.to_string(),
-            reason: e.to_string(),
+            reason: wrong_type_reason(scene, key, before.as_ref(), &shown)
+                .unwrap_or_else(|| e.to_string()),
         })?;
     // A list where the scene has an object would be read by position.
     whirlmap_core::json::check_objects(&root, &parsed).map_err(|reason| {
@@ -144,6 +150,52 @@ pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideE
     })?;
     *scene = parsed;
     Ok(())
+}
+
+/// The value at the dotted `key` in `root`, if it is there (an optional field at its
+/// default is absent).
+fn get_value<'v>(root: &'v Value, key: &str) -> Option<&'v Value> {
+    key.split('.').try_fold(root, |node, part| node.get(part))
+}
+
+/// Whether `value` at `key` makes a scene (of the right kind; its range is not checked).
+fn parses(scene: &Scene, key: &str, value: Value) -> bool {
+    let mut root = serde_json::to_value(scene).expect("a scene serialises");
+    set_value(&mut root, key, value).is_ok() && serde_json::from_value::<Scene>(root).is_ok()
+}
+
+/// What a value of the wrong kind for `key` should have been, in the user's words, from the
+/// kinds the field takes (tried with a probe value, so an optional field absent at its
+/// default is covered too): `abc` is not a number, with the field's allowed range; `maybe` is
+/// not true or false; `[1,x]` is not a list of 2 numbers, with an example. `None` for the
+/// other kinds (an enum's unknown variant, a section), whose serde message names the choices.
+fn wrong_type_reason(
+    scene: &Scene,
+    key: &str,
+    before: Option<&Value>,
+    shown: &str,
+) -> Option<String> {
+    if parses(scene, key, Value::from(0.0)) {
+        return Some(format!(
+            "`{shown}` is not a number; allowed {}",
+            finite_range(scene, key)
+        ));
+    }
+    if parses(scene, key, Value::Bool(false)) {
+        return Some(format!("`{shown}` is not `true` or `false`"));
+    }
+    let example = match before {
+        Some(Value::Array(items)) if items.iter().all(Value::is_number) => {
+            Value::Array(items.clone())
+        }
+        _ => (1..=4)
+            .map(|n| Value::Array(vec![Value::from(0.0); n]))
+            .find(|v| parses(scene, key, v.clone()))?,
+    };
+    let n = example.as_array().map_or(0, Vec::len);
+    Some(format!(
+        "`{shown}` is not a list of {n} numbers; write it as `{example}`"
+    ))
 }
 
 /// Sets `key` (dotted for nested fields) to `value` in `root`, a scene as JSON (from
@@ -294,6 +346,60 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("unknown variant `inf`"), "{e}");
+    }
+
+    #[test]
+    fn a_value_of_the_wrong_kind_says_what_the_field_takes() {
+        let mut s = Scene::paper();
+        for (set, says) in [
+            (
+                "solver.rtol=abc",
+                "`abc` is not a number; allowed (0, 1e-2]",
+            ),
+            (
+                "clearance_m=\"wide\"",
+                "`wide` is not a number; allowed (0, 0.1] m",
+            ),
+            (
+                "clearance_m=[1,2]",
+                "`[1,2]` is not a number; allowed (0, 0.1] m",
+            ),
+            // An optional number at its default is absent from the scene's JSON.
+            (
+                "race_speed_rad_s=fast",
+                "`fast` is not a number; allowed [-1e5, 1e5] rad/s",
+            ),
+            ("drag_enabled=maybe", "`maybe` is not `true` or `false`"),
+            ("drag_enabled=1", "`1` is not `true` or `false`"),
+            (
+                "release_offset_m=[1,x]",
+                "`[1,x]` is not a list of 2 numbers; write it as `[0.0,0.0]`",
+            ),
+            (
+                "release_offset_m=[1,2,3]",
+                "`[1,2,3]` is not a list of 2 numbers; write it as `[0.0,0.0]`",
+            ),
+        ] {
+            let e = apply_assignment(&mut s, set).unwrap_err().to_string();
+            let key = set.split('=').next().unwrap();
+            assert!(
+                e.contains(&format!("`{key}`")) && e.contains(says),
+                "{set}: {e}"
+            );
+            assert!(
+                !e.contains("f64") && !e.contains("invalid type"),
+                "{set}: {e}"
+            );
+        }
+        assert_eq!(s, Scene::paper(), "nothing was set");
+        // An enum keeps serde's message, which lists the choices.
+        let e = apply_assignment(&mut s, "solver.method=fast")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("unknown variant `fast`") && e.contains("rodas4"),
+            "{e}"
+        );
     }
 
     #[test]
