@@ -146,11 +146,24 @@ impl Figure for Fig4<'_> {
                 .chain(band.iter().rev().map(|b| (b.mu, b.p[2])))
                 .collect();
             chart.draw_series([Polygon::new(poly, PROB.mix(0.16).filled())])?;
+            // Each edge segment solid where both its ends are crossings the ensemble reached,
+            // dotted where one end is only the ensemble's top speed (the band goes on above
+            // it there, unmeasured).
             for k in [0, 2] {
-                chart.draw_series([PathElement::new(
-                    band.iter().map(|b| (b.mu, b.p[k])).collect::<Vec<_>>(),
-                    PROB.mix(0.5).stroke_width(1),
-                )])?;
+                for w in band.windows(2) {
+                    let seg = vec![(w[0].mu, w[0].p[k]), (w[1].mu, w[1].p[k])];
+                    if w[0].reached[k] && w[1].reached[k] {
+                        chart
+                            .draw_series([PathElement::new(seg, PROB.mix(0.5).stroke_width(1))])?;
+                    } else {
+                        chart.draw_series([DashedPathElement::new(
+                            seg,
+                            2,
+                            4,
+                            PROB.mix(0.8).stroke_width(1),
+                        )])?;
+                    }
+                }
             }
             chart.draw_series([DashedPathElement::new(
                 band.iter().map(|b| (b.mu, b.p[1])).collect::<Vec<_>>(),
@@ -169,7 +182,9 @@ impl Figure for Fig4<'_> {
         let canvas = pa.strip_coord_spec();
 
         // The band's 50 % points: filled where the ensemble reached 50 %, open where it did not
-        // within its speed range (the point then sits at the ensemble's top speed).
+        // within its speed range (the point then sits at the ensemble's top speed). The 90 %
+        // edge: an open circle where the ensemble did not reach 90 % (the band is clipped at
+        // its top speed there, not closed).
         let mut any_clipped = false;
         if band.len() >= 2 {
             for b in band {
@@ -180,6 +195,12 @@ impl Figure for Fig4<'_> {
                     any_clipped = true;
                     canvas.draw(&Circle::new(p, 5, WHITE.filled()))?;
                     canvas.draw(&Circle::new(p, 5, PROB.stroke_width(2)))?;
+                }
+                if !b.reached[2] && b.reached[1] {
+                    any_clipped = true;
+                    let q = px(b.mu, b.p[2]);
+                    canvas.draw(&Circle::new(q, 5, WHITE.filled()))?;
+                    canvas.draw(&Circle::new(q, 5, PROB.stroke_width(2)))?;
                 }
             }
         }
@@ -377,12 +398,28 @@ impl Figure for Fig4<'_> {
                 if any_clipped {
                     entries.push((
                         Mark::OpenDot(PROB),
-                        "50 % not reached by the ensemble's top speed".to_string(),
+                        format!(
+                            "{} not reached by the ensemble's top speed (dotted: open above)",
+                            clipped_levels(band)
+                        ),
                     ));
                 }
             }
         }
         legend(&legend_band, &entries)
+    }
+}
+
+/// Which of the band's 50 % and 90 % levels some friction coefficient did not reach, for
+/// the legend ("50 %", "90 %" or "50 % or 90 %").
+fn clipped_levels(band: &[BandPoint]) -> &'static str {
+    match (
+        band.iter().any(|b| !b.reached[1]),
+        band.iter().any(|b| !b.reached[2] && b.reached[1]),
+    ) {
+        (true, true) => "50 % or 90 %",
+        (false, true) => "90 %",
+        _ => "50 %",
     }
 }
 
@@ -549,6 +586,54 @@ mod tests {
             note: String::new(),
         });
         assert_ne!(draw(&relocated, "relocated"), drawn);
+    }
+
+    /// A band whose 90 % level one friction coefficient never reaches is drawn open there
+    /// (a dotted edge and an open circle at the ensemble's top speed), not closed at it: the
+    /// same numbers marked reached draw a different picture, and the legend names the level.
+    /// Both pictures are kept under the temp folder when `WHIRLMAP_KEEP_CHART` is set.
+    #[test]
+    fn a_band_that_never_reaches_90_percent_is_drawn_open_at_the_top() {
+        let (rows, _) = paper_rows_at_mu_0_4();
+        let clipped = [
+            BandPoint {
+                mu: 0.25,
+                p: [7200.0, 12800.0, 16000.0],
+                reached: [true, true, false],
+            },
+            BandPoint {
+                mu: 0.4,
+                p: [2600.0, 4600.0, 5900.0],
+                reached: [true, true, true],
+            },
+        ];
+        let mut closed = clipped;
+        closed[0].reached[2] = true;
+        let draw = |band: &[BandPoint], tag: &str| {
+            let path = std::env::temp_dir()
+                .join(format!("whirlmap-fig4-{tag}-{}.png", std::process::id()));
+            let fig = Fig4 {
+                rows: &rows,
+                band: Some((band, "(test)".into())),
+                title: tag.into(),
+            };
+            crate::render::render(&path, (1000, 700), &fig).unwrap();
+            let bytes = std::fs::read(&path).unwrap();
+            if std::env::var_os("WHIRLMAP_KEEP_CHART").is_some() {
+                eprintln!("chart: {}", path.display());
+            } else {
+                std::fs::remove_file(&path).ok();
+            }
+            bytes
+        };
+        assert_ne!(draw(&clipped, "band-open"), draw(&closed, "band-closed"));
+        assert_eq!(clipped_levels(&clipped), "90 %");
+        let mut none_at_50 = clipped;
+        none_at_50[1].reached[1] = false;
+        none_at_50[1].reached[2] = false;
+        assert_eq!(clipped_levels(&none_at_50), "50 % or 90 %");
+        none_at_50[0].reached[2] = true;
+        assert_eq!(clipped_levels(&none_at_50), "50 %");
     }
 
     #[test]
