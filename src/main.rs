@@ -477,7 +477,7 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
     }
     if let (Some(path), Some(orbit)) = (&a.orbit, &report.orbit) {
         let title = format!(
-            "{:.0} r/min, mu = {:.2}{}: {}",
+            "{:.0} r/min, μ = {:.2}{}: {}",
             scene.speed_rpm,
             scene.mu_dynamic,
             settings_note(&scene),
@@ -487,7 +487,7 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
     }
     if let (Some(path), Some(th)) = (&a.temperatures, &report.thermal) {
         let title = format!(
-            "{:.0} r/min, mu = {:.2}{}: touchdown bearing temperatures over {} s",
+            "{:.0} r/min, μ = {:.2}{}: touchdown bearing temperatures over {} s",
             scene.speed_rpm,
             scene.mu_dynamic,
             settings_note(&scene),
