@@ -166,8 +166,8 @@ fn parses(scene: &Scene, key: &str, value: Value) -> bool {
 
 /// What a value of the wrong kind for `key` should have been, in the user's words, from the
 /// kinds the field takes (tried with a probe value, so an optional field absent at its
-/// default is covered too): `abc` is not a number, with the field's allowed range; `maybe` is
-/// not true or false; `[1,x]` is not a list of 2 numbers, with an example. `None` for the
+/// default is covered too): `abc` is not a number, with the field's allowed range; `1.5` is
+/// not a whole number (a count); `maybe` is not true or false; `[1,x]` is not a list of 2 numbers, with an example. `None` for the
 /// other kinds (an enum's unknown variant, a section), whose serde message names the choices.
 fn wrong_type_reason(
     scene: &Scene,
@@ -179,6 +179,17 @@ fn wrong_type_reason(
         return Some(format!(
             "`{shown}` is not a number; allowed {}",
             finite_range(scene, key)
+        ));
+    }
+    if parses(scene, key, Value::from(0_u64)) {
+        // A count: the validation's words for 0 give its range when 0 is not allowed.
+        let mut s = scene.clone();
+        let allowed = match apply(&mut s, key, Value::from(0_u64)).map(|()| s.validate()) {
+            Ok(Err(e)) if e.field == key => e.allowed,
+            _ => ">= 0".to_string(),
+        };
+        return Some(format!(
+            "`{shown}` is not a whole number; allowed {allowed}"
         ));
     }
     if parses(scene, key, Value::Bool(false)) {
@@ -368,6 +379,18 @@ mod tests {
             (
                 "race_speed_rad_s=fast",
                 "`fast` is not a number; allowed [-1e5, 1e5] rad/s",
+            ),
+            (
+                "solver.max_step_attempts=abc",
+                "`abc` is not a whole number; allowed >= 1",
+            ),
+            (
+                "solver.max_step_attempts=1.5",
+                "`1.5` is not a whole number; allowed >= 1",
+            ),
+            (
+                "solver.max_step_attempts=-1",
+                "`-1` is not a whole number; allowed >= 1",
             ),
             ("drag_enabled=maybe", "`maybe` is not `true` or `false`"),
             ("drag_enabled=1", "`1` is not `true` or `false`"),
