@@ -60,20 +60,39 @@ fn did_you_mean_text(suggestion: Option<&str>) -> String {
         .unwrap_or_default()
 }
 
-/// Adds a "did you mean" to serde's `unknown field `x`, expected one of `a`, `b`` message
-/// (a scene or sweep file with a misspelt key); any other message is returned as it is.
+/// serde's message about a scene or sweep file, for its user: a "did you mean" added to an
+/// `unknown field `x`, expected one of `a`, `b`` message (a misspelt key), and Rust's type
+/// names in an `expected ...` put in words (`expected f64` reads `expected a number`,
+/// `expected u64` `expected a whole number, 0 or more`, `expected a boolean` `expected true
+/// or false`); any other message is returned as it is.
 pub fn with_suggestion(message: &str) -> String {
+    let message = plain_types(message);
     let Some(rest) = message.split("unknown field `").nth(1) else {
-        return message.to_string();
+        return message;
     };
     let Some((given, tail)) = rest.split_once('`') else {
-        return message.to_string();
+        return message;
     };
     let known: Vec<&str> = tail.split('`').skip(1).step_by(2).collect();
     match did_you_mean(given, known) {
         Some(best) => format!("{message} (did you mean `{best}`?)"),
-        None => message.to_string(),
+        None => message,
     }
+}
+
+/// Rust's type names in serde's `expected ...` put in words (see [`with_suggestion`]).
+fn plain_types(message: &str) -> String {
+    [
+        ("expected f64", "expected a number"),
+        ("expected u64", "expected a whole number, 0 or more"),
+        ("expected usize", "expected a whole number, 0 or more"),
+        ("expected u32", "expected a whole number, 0 or more"),
+        ("expected a boolean", "expected true or false"),
+    ]
+    .into_iter()
+    .fold(message.to_string(), |m, (rust, words)| {
+        m.replace(rust, words)
+    })
 }
 
 /// Parses `key=value` and applies it to `scene`.
@@ -448,6 +467,29 @@ mod tests {
             "{err}"
         );
         assert_eq!(with_suggestion("expected value"), "expected value");
+        // A value of the wrong type in a file: the field's path, the value, and the type in
+        // words.
+        let text = r#"{"solver": {"rtol": "x"}, "drag_enabled": 1}"#;
+        let err = whirlmap_core::json::from_str::<Scene>(text).unwrap_err();
+        let said = with_suggestion(&err.to_string());
+        assert!(
+            said.contains("solver.rtol") && said.contains("\"x\", expected a number"),
+            "{said}"
+        );
+        let text = r#"{"drag_enabled": 1}"#;
+        let err = whirlmap_core::json::from_str::<Scene>(text).unwrap_err();
+        let said = with_suggestion(&err.to_string());
+        assert!(
+            said.contains("drag_enabled") && said.contains("expected true or false"),
+            "{said}"
+        );
+        let text = r#"{"solver": {"max_events": -3}}"#;
+        let err = whirlmap_core::json::from_str::<Scene>(text).unwrap_err();
+        let said = with_suggestion(&err.to_string());
+        assert!(
+            said.contains("expected a whole number, 0 or more"),
+            "{said}"
+        );
     }
 
     #[test]
