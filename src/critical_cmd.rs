@@ -244,7 +244,7 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                 fmt_rpm(hi),
                 if r.undecided {
                     ", UNDECIDED: failed drops below it"
-                } else if r.recheck.as_ref().is_some_and(|rc| !rc.confirmed) {
+                } else if r.recheck.as_ref().is_some_and(|rc| !rc.holds()) {
                     ", NOT CONFIRMED by the re-check"
                 } else if r.converged {
                     ""
@@ -310,9 +310,11 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                 fmt_rpm(rc.hi.0),
                 show(&rc.hi.1),
                 if rc.confirmed {
-                    "bracket confirmed"
+                    "bracket confirmed".to_string()
+                } else if rc.within_tol {
+                    format!("the onset holds to {} r/min", fmt_rpm(r.tol_rpm))
                 } else {
-                    "NOT confirmed"
+                    "NOT confirmed".to_string()
                 }
             );
             if let Some(w) = &rc.relocated {

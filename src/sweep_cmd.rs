@@ -85,7 +85,7 @@ pub(crate) fn critical_line(dir: &Path, path: &Path) -> bool {
             .collect()
     };
     let undecided = list(&|r| r.undecided);
-    let unconfirmed = list(&|r| r.recheck.as_ref().is_some_and(|rc| !rc.confirmed));
+    let unconfirmed = list(&|r| r.recheck.as_ref().is_some_and(|rc| !rc.holds()));
     let mut parts = Vec::new();
     if !undecided.is_empty() {
         parts.push(format!(

@@ -248,11 +248,7 @@ impl Figure for Fig4<'_> {
         for (r, o) in rows.iter().zip(&onsets) {
             let Some((mu, s)) = o else { continue };
             let p = px(*mu, *s);
-            if let Some(rc) = r
-                .recheck
-                .as_ref()
-                .filter(|rc| !rc.confirmed && !r.undecided)
-            {
+            if let Some(rc) = r.recheck.as_ref().filter(|rc| !rc.holds() && !r.undecided) {
                 // The tighter preset disagrees: an open square, and where that preset puts
                 // the onset, when its window search found it: a diamond, joined by a dotted
                 // line.
@@ -427,7 +423,7 @@ fn clipped_levels(band: &[BandPoint]) -> &'static str {
 /// onset is undecided or left unconfirmed by a re-check.
 fn joined(a: &CriticalRow, b: &CriticalRow) -> bool {
     let sure = |r: &CriticalRow| {
-        r.onset_rpm.is_some() && !r.undecided && r.recheck.as_ref().is_none_or(|rc| rc.confirmed)
+        r.onset_rpm.is_some() && !r.undecided && r.recheck.as_ref().is_none_or(|rc| rc.holds())
     };
     sure(a) && sure(b)
 }
@@ -544,6 +540,7 @@ mod tests {
             lo: (lo, Outcome::Class(OrbitClass::BackwardWhirl)),
             hi: (hi, Outcome::Class(OrbitClass::BackwardWhirl)),
             confirmed,
+            within_tol: false,
             relocated: None,
         };
         let draw = |rows: &[CriticalRow], tag: &str| {
@@ -586,6 +583,21 @@ mod tests {
             note: String::new(),
         });
         assert_ne!(draw(&relocated, "relocated"), drawn);
+        // The same window search putting the onset within the row's tolerance of it: the
+        // onset holds, and is drawn and joined as a confirmed one.
+        let mut within = unconfirmed.clone();
+        let tol = within[i].tol_rpm;
+        let rc = within[i].recheck.as_mut().unwrap();
+        rc.within_tol = true;
+        rc.relocated = Some(Relocated {
+            window_rpm: [lo - 1000.0, hi + 500.0],
+            onset_rpm: Some(hi - tol),
+            drops: 10,
+            note: String::new(),
+        });
+        let w = &within;
+        assert!(joined(&w[i - 1], &w[i]) && joined(&w[i], &w[i + 1]));
+        assert_eq!(draw(&within, "within-tol"), plain);
     }
 
     /// A band whose 90 % level one friction coefficient never reaches is drawn open there

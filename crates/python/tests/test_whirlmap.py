@@ -10,6 +10,7 @@ import re
 import signal
 import threading
 import traceback
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Iterator
@@ -208,6 +209,19 @@ def test_critical_warns_when_unsettled_drops_leave_the_onset_undecided() -> None
         )  # fmt: skip
     assert rows[0]["undecided"] is True
     assert rows[0]["note"].startswith("UNDECIDED: 1 drop(s) below the onset")
+
+
+def test_an_onset_the_re_check_finds_again_within_the_tolerance_holds() -> None:
+    # At mu 0.4 standard gives another class at draft's bracket end, 4390.625 r/min, but
+    # puts the onset at 4375 r/min, within the 25 r/min tolerance: no warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        rows = whirlmap.critical(0.4, from_rpm=1000, to_rpm=5000, fidelity="draft")
+    rc = rows[0]["recheck"]
+    assert rc["confirmed"] is False and rc["within_tol"] is True
+    assert abs(rc["relocated"]["onset_rpm"] - rows[0]["onset_rpm"]) <= 25.0
+    assert rows[0]["converged"] is True
+    assert rows[0]["note"].startswith("the onset holds to 25 r/min at the re-check at standard")
 
 
 def test_critical_warns_when_the_re_check_does_not_confirm_the_onset() -> None:

@@ -93,7 +93,7 @@ pub struct CriticalRow {
     pub failed_drops: usize,
     /// Every bisection reached `tol_rpm`, no failed drop leaves the onset undecided (false
     /// whenever `undecided` is true) and, when the bracket was re-checked at a tighter
-    /// preset, the re-check confirmed it ([`Recheck::apply_to`]).
+    /// preset, the onset holds there ([`Recheck::holds`], [`Recheck::apply_to`]).
     pub converged: bool,
     /// Failed drops leave the onset undecided: every scan drop failed, or a drop failed
     /// below the reported onset (inside its bracket included), where a whirl would have
@@ -207,8 +207,8 @@ pub fn undecided_summary(rows: &[CriticalRow]) -> Option<String> {
     (!list.is_empty()).then(|| list.join(", "))
 }
 
-/// The rows whose onset bracket the re-check at the tighter preset did not confirm, in
-/// words (`mu 0.25 (at standard: 13312.5 r/min backward_whirl, 13375 r/min
+/// The rows whose onset does not hold at the re-check's tighter preset ([`Recheck::holds`]),
+/// in words (`mu 0.25 (at standard: 13312.5 r/min backward_whirl, 13375 r/min
 /// backward_whirl)`); `None` when every re-checked bracket was confirmed or none was
 /// re-checked. The command line then exits 1, as the Python package warns: the onset the
 /// search's own preset found is not the tighter preset's.
@@ -216,7 +216,7 @@ pub fn unconfirmed_summary(rows: &[CriticalRow]) -> Option<String> {
     let list: Vec<String> = rows
         .iter()
         .filter_map(|r| {
-            let rc = r.recheck.as_ref().filter(|rc| !rc.confirmed)?;
+            let rc = r.recheck.as_ref().filter(|rc| !rc.holds())?;
             Some(format!("mu {} ({})", r.mu, rc.outcomes()))
         })
         .collect();
@@ -234,6 +234,13 @@ pub struct Recheck {
     pub hi: (f64, Outcome),
     /// True when the tighter preset also gives no whirl at `lo` and whirl at `hi`.
     pub confirmed: bool,
+    /// True when the bracket is not confirmed but the tighter preset's onset, searched again
+    /// (`relocated`), lies within the row's `tol_rpm` of the row's onset: the onset holds to
+    /// the tolerance the search was asked for, though a bracket end's class differs at the
+    /// tighter preset (near an onset the class can flip within tens of r/min). Written only
+    /// when true; absent reads as false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub within_tol: bool,
     /// Where the tighter preset puts the onset, when it does not confirm the bracket.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub relocated: Option<Relocated>,
@@ -263,6 +270,19 @@ pub struct Relocated {
 }
 
 impl Recheck {
+    /// Whether the onset holds at the tighter preset: the bracket confirmed, or the tighter
+    /// preset's onset within the search's tolerance of it (`within_tol`).
+    pub fn holds(&self) -> bool {
+        self.confirmed || self.within_tol
+    }
+
+    /// Whether the tighter preset's onset, searched again in `relocated`, lies within
+    /// `tol_rpm` of `onset_rpm` (the row's). False without either onset.
+    pub fn onset_within(&self, onset_rpm: Option<f64>, tol_rpm: f64) -> bool {
+        let found = self.relocated.as_ref().and_then(|r| r.onset_rpm);
+        matches!((found, onset_rpm), (Some(a), Some(b)) if (a - b).abs() <= tol_rpm)
+    }
+
     /// The two drops at the tighter preset, in words: `at standard: 13312.5 r/min
     /// backward_whirl, 13375 r/min backward_whirl` (a failed drop reads `failed`), then,
     /// when the onset was searched again there, the window's note ([`Relocated::note`]).
@@ -290,15 +310,27 @@ impl Recheck {
         2 + self.relocated.as_ref().map_or(0, |r| r.drops)
     }
 
-    /// Records this re-check in `row`. One the tighter preset does not confirm makes the row
-    /// not converged (its onset is the search preset's only) and puts `NOT CONFIRMED` and
-    /// the two drops ([`Recheck::outcomes`]) in its note, so that `critical.csv`, which has no
-    /// re-check columns, says it too: at the head of the note, or after the note of an
-    /// undecided row, which starts with `UNDECIDED`.
+    /// Records this re-check in `row`. One whose onset does not hold at the tighter preset
+    /// ([`Recheck::holds`]) makes the row not converged (its onset is the search preset's
+    /// only) and puts `NOT CONFIRMED` and the two drops ([`Recheck::outcomes`]) in its note,
+    /// so that `critical.csv`, which has no re-check columns, says it too: at the head of the
+    /// note, or after the note of an undecided row, which starts with `UNDECIDED`. One that
+    /// holds only within the tolerance (`within_tol`) says so in the note, in the same place,
+    /// and leaves `converged` as it was.
     pub fn apply_to(self, row: &mut CriticalRow) {
-        if !self.confirmed {
+        let clause = if !self.holds() {
             row.converged = false;
-            let clause = format!("NOT CONFIRMED by the re-check {}", self.outcomes());
+            Some(format!("NOT CONFIRMED by the re-check {}", self.outcomes()))
+        } else if self.within_tol {
+            Some(format!(
+                "the onset holds to {} r/min at the re-check {}",
+                row.tol_rpm,
+                self.outcomes()
+            ))
+        } else {
+            None
+        };
+        if let Some(clause) = clause {
             row.note = if row.undecided {
                 format!("{}; {clause}", row.note)
             } else {
@@ -357,6 +389,7 @@ mod tests {
             lo: (13312.5, Outcome::Class(OrbitClass::BackwardWhirl)),
             hi: (13375.0, Outcome::Failed("step_budget: x".into())),
             confirmed,
+            within_tol: false,
             relocated: None,
         }
     }
@@ -387,5 +420,54 @@ mod tests {
         recheck(true).apply_to(&mut c);
         assert!(c.converged && c.recheck.is_some());
         assert_eq!(c.note, "pendulum at 13312.5 r/min");
+    }
+
+    /// A re-check whose tighter preset puts the onset within the row's tolerance of it holds:
+    /// the row stays converged and its note says to what tolerance; one tolerance further
+    /// and it does not.
+    #[test]
+    fn an_onset_found_again_within_the_tolerance_holds() {
+        let with_onset = |onset: f64| {
+            let mut rc = recheck(false);
+            rc.relocated = Some(Relocated {
+                window_rpm: [11000.0, 16000.0],
+                onset_rpm: Some(onset),
+                drops: 7,
+                note: format!("its onset there {onset} r/min"),
+            });
+            rc
+        };
+        let r = row(false, "pendulum at 13312.5 r/min");
+        // The row's onset is 13 375 r/min and its tolerance 100 r/min.
+        assert!(with_onset(13275.0).onset_within(r.onset_rpm, r.tol_rpm));
+        assert!(with_onset(13475.0).onset_within(r.onset_rpm, r.tol_rpm));
+        assert!(!with_onset(13274.0).onset_within(r.onset_rpm, r.tol_rpm));
+        assert!(!with_onset(13275.0).onset_within(None, r.tol_rpm));
+        assert!(!recheck(false).onset_within(r.onset_rpm, r.tol_rpm));
+
+        let mut held = r.clone();
+        let mut rc = with_onset(13300.0);
+        rc.within_tol = true;
+        assert!(rc.holds());
+        rc.apply_to(&mut held);
+        assert!(held.converged);
+        assert!(
+            held.note.starts_with(
+                "the onset holds to 100 r/min at the re-check at standard: 13312.5 r/min \
+                 backward_whirl, 13375 r/min failed; its onset there 13300 r/min; pendulum"
+            ),
+            "{}",
+            held.note
+        );
+        assert_eq!(unconfirmed_summary(std::slice::from_ref(&held)), None);
+        // The field is written only when true, so older rows read back to the same bytes.
+        let json = serde_json::to_string(held.recheck.as_ref().unwrap()).unwrap();
+        assert!(json.contains("\"within_tol\":true"), "{json}");
+        let mut not_held = r.clone();
+        with_onset(13000.0).apply_to(&mut not_held);
+        assert!(!not_held.converged && not_held.note.starts_with("NOT CONFIRMED"));
+        let json = serde_json::to_string(not_held.recheck.as_ref().unwrap()).unwrap();
+        assert!(!json.contains("within_tol"), "{json}");
+        assert!(unconfirmed_summary(&[not_held]).is_some());
     }
 }

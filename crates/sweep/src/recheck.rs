@@ -98,13 +98,16 @@ fn recheck_with(
     let confirmed = settled_below && out_hi.whirl() == Some(true);
     let relocated =
         (!confirmed).then(|| relocate(&s, row, [(lo, &out_lo), (hi, &out_hi)], run, ticker));
-    Some(Recheck {
+    let mut rc = Recheck {
         fidelity: tighter,
         lo: (lo, out_lo),
         hi: (hi, out_hi),
         confirmed,
+        within_tol: false,
         relocated,
-    })
+    };
+    rc.within_tol = !confirmed && rc.onset_within(row.onset_rpm, row.tol_rpm);
+    Some(rc)
 }
 
 /// Lattice steps either side of the bracket that [`relocate`] searches first: the convergence
@@ -352,7 +355,7 @@ mod tests {
         for tighter_at in [4100.0, 4600.0] {
             let (rc, ran) = recheck(4321.0, tighter_at, &[]);
             let w = rc.relocated.expect("searched again");
-            assert!(!rc.confirmed);
+            assert!(!rc.confirmed && !rc.within_tol);
             assert_eq!(
                 w.window_rpm,
                 [3750.0, 5000.0],
@@ -369,6 +372,25 @@ mod tests {
             let [lo, hi] = row(4321.0).bracket_rpm.unwrap();
             assert_eq!(ran.iter().filter(|&&s| s == lo || s == hi).count(), 2);
         }
+    }
+
+    /// An onset the tighter preset puts within the row's tolerance (10 r/min) of the row's
+    /// holds though a bracket end's class differs there; one just beyond it does not.
+    #[test]
+    fn an_onset_found_again_within_the_tolerance_holds() {
+        assert_eq!(row(4321.0).onset_rpm, Some(4328.125));
+        // Whirl from 4318: the search's lower end, 4320.3125, whirls there, and its onset is
+        // 4320.3125, 7.8 r/min lower.
+        let (rc, _) = recheck(4321.0, 4318.0, &[]);
+        assert_eq!(row(4318.0).onset_rpm, Some(4320.3125));
+        assert!(!rc.confirmed && rc.within_tol && rc.holds(), "{rc:?}");
+        // Whirl from 4310: its onset 4312.5, 15.6 r/min lower.
+        let (rc, _) = recheck(4321.0, 4310.0, &[]);
+        assert_eq!(row(4310.0).onset_rpm, Some(4312.5));
+        assert!(!rc.confirmed && !rc.within_tol && !rc.holds(), "{rc:?}");
+        // A confirmed bracket is not marked within the tolerance: it needs no window.
+        let (rc, _) = recheck(4321.0, 4321.0, &[]);
+        assert!(rc.confirmed && !rc.within_tol);
     }
 
     /// A bracket end the window meets again, as a scan point (an end on the lattice) or as a

@@ -292,7 +292,8 @@ def critical(
             names the friction coefficients and their failed or unsettled drops. Every row
             is returned.
             Also when, with a ``fidelity`` preset, the re-check at the next tighter preset
-            does not confirm some row's onset bracket (the command line exits 1 then too);
+            does not confirm some row's onset bracket and does not find that preset's onset
+            within ``tol_rpm`` of it (``within_tol``; the command line exits 1 then too);
             that row's ``converged`` is then false and its ``note`` says ``NOT CONFIRMED by
             the re-check`` (at its head, or at the end of an undecided row's note, which
             starts with ``UNDECIDED``). The search then runs again at the tighter preset
@@ -354,7 +355,10 @@ def critical(
             stacklevel=2,
         )
     unconfirmed = [
-        f"mu {r['mu']}" for r in rows if r.get("recheck") and not r["recheck"]["confirmed"]
+        f"mu {r['mu']}"
+        for r in rows
+        if r.get("recheck")
+        and not (r["recheck"]["confirmed"] or r["recheck"].get("within_tol", False))
     ]
     if unconfirmed:
         warnings.warn(
