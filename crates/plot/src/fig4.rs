@@ -6,11 +6,12 @@
 //! - the **onset** of sustained whirl per friction coefficient as one curve (dots joined
 //!   between neighbouring coefficients that both whirl in the range); an onset found already
 //!   at the lowest scanned speed carries a downward arrow (at or below it); an onset that
-//!   failed or unsettled drops leave undecided (`undecided` in `critical.json`) is an open circle, joined
-//!   to no neighbour; an onset that does not hold at the re-check's tighter preset (`recheck`
-//!   in `critical.json`, neither `confirmed` nor `within_tol`) is an open square (an open circle when it is undecided
-//!   too), joined to no neighbour, with a dark diamond, joined by a dotted line, where the
-//!   tighter preset's window search put the onset (`recheck.relocated`);
+//!   failed or unsettled drops leave undecided (`undecided` in `critical.json`) is an open
+//!   circle, joined to no neighbour; an onset that does not hold at the re-check's tighter
+//!   preset (`recheck` in `critical.json`, neither `confirmed` nor `within_tol`) is an open
+//!   square (an open circle when it is undecided too), joined to no neighbour, with a dark
+//!   diamond, joined by a dotted line, where the tighter preset's window search put the onset
+//!   (`recheck.relocated`);
 //! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
 //!   to the top of the searched range;
 //! - **no whirl in range** as an open triangle at the range top;
