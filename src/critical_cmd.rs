@@ -101,7 +101,7 @@ fn flag_error(e: InvalidParameter) -> Failure {
 }
 
 /// Runs the subcommand: `Flagged` (exit 1) when failed drops left some row's onset
-/// undecided or the re-check did not confirm one, after every row is printed and written.
+/// undecided or one does not hold at the re-check, after every row is printed and written.
 pub fn run(a: &CriticalArgs) -> CmdResult {
     let opts = CriticalOptions {
         from_rpm: a.from,
@@ -194,8 +194,9 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
     Ok(Done::flagged_if(undecided || unconfirmed))
 }
 
-/// Says on standard error which rows' onsets the re-check at the next tighter preset did
-/// not confirm (the `sweep` command shares it); true when there are some.
+/// Says on standard error which rows' onsets do not hold at the re-check at the next tighter
+/// preset ([`whirlmap_results::critical::Recheck::holds`]; the `sweep` command shares it);
+/// true when there are some.
 pub(crate) fn report_unconfirmed(rows: &[CriticalRow]) -> bool {
     let Some(list) = whirlmap_sweep::critical::unconfirmed_summary(rows) else {
         return false;

@@ -30,7 +30,7 @@ pub struct MergeArgs {
 }
 
 /// Runs the subcommand: `Flagged` (exit 1) when some points failed, failed drops left a
-/// critical speed undecided or the re-check did not confirm an onset.
+/// critical speed undecided or an onset does not hold at the re-check.
 pub fn run(a: &MergeArgs) -> CmdResult {
     let out = match &a.out {
         Some(o) => o.clone(),

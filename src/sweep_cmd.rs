@@ -70,9 +70,9 @@ pub(crate) fn counts(outcome: &SweepOutcome) -> String {
 }
 
 /// Prints the summary line of the critical speeds in `dir` (`critical.json` at `path`),
-/// with how many rows failed drops left undecided and how many the re-check at a tighter
-/// preset did not confirm, and says which on standard error (as `whirlmap critical` does).
-/// True when some row is undecided or not confirmed. The sweep, shard and merge commands
+/// with how many rows failed drops left undecided and how many onsets do not hold at the
+/// re-check at a tighter preset, and says which on standard error (as `whirlmap critical`
+/// does). True when some row is undecided or its onset does not hold. The sweep, shard and merge commands
 /// share it.
 pub(crate) fn critical_line(dir: &Path, path: &Path) -> bool {
     let rows = whirlmap_sweep::results::critical::read_critical(dir)
@@ -118,7 +118,7 @@ pub(crate) fn critical_line(dir: &Path, path: &Path) -> bool {
 }
 
 /// Runs the subcommand: `Flagged` (exit 1) when some points failed, failed drops left a
-/// critical speed undecided or the re-check did not confirm an onset.
+/// critical speed undecided or an onset does not hold at the re-check.
 pub fn run(a: &SweepArgs) -> CmdResult {
     let spec = spec::read(&a.file).map_err(|e| Failure::coded(2, e))?;
     if let (Some(i), Some(n)) = (a.shard, a.shards) {

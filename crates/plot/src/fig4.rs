@@ -586,16 +586,18 @@ mod tests {
         assert_ne!(draw(&relocated, "relocated"), drawn);
         // The same window search putting the onset within the row's tolerance of it: the
         // onset holds, and is drawn and joined as a confirmed one.
-        let mut within = unconfirmed.clone();
-        let tol = within[i].tol_rpm;
-        let rc = within[i].recheck.as_mut().unwrap();
-        rc.within_tol = true;
+        let mut within = rows.clone();
+        let mut rc = recheck(false);
         rc.relocated = Some(Relocated {
             window_rpm: [lo - 1000.0, hi + 500.0],
-            onset_rpm: Some(hi - tol),
+            onset_rpm: Some(hi - within[i].tol_rpm),
             drops: 10,
             note: String::new(),
         });
+        rc.within_tol = rc.onset_within(within[i].onset_rpm, within[i].tol_rpm);
+        assert!(rc.within_tol);
+        rc.apply_to(&mut within[i]);
+        assert!(within[i].converged);
         let w = &within;
         assert!(joined(&w[i - 1], &w[i]) && joined(&w[i], &w[i + 1]));
         assert_eq!(draw(&within, "within-tol"), plain);

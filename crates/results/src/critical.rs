@@ -209,8 +209,7 @@ pub fn undecided_summary(rows: &[CriticalRow]) -> Option<String> {
 
 /// The rows whose onset does not hold at the re-check's tighter preset ([`Recheck::holds`]),
 /// in words (`mu 0.25 (at standard: 13312.5 r/min backward_whirl, 13375 r/min
-/// backward_whirl)`); `None` when every re-checked bracket was confirmed or none was
-/// re-checked. The command line then exits 1, as the Python package warns: the onset the
+/// backward_whirl)`); `None` when every re-checked onset holds or none was re-checked. The command line then exits 1, as the Python package warns: the onset the
 /// search's own preset found is not the tighter preset's.
 pub fn unconfirmed_summary(rows: &[CriticalRow]) -> Option<String> {
     let list: Vec<String> = rows
@@ -235,7 +234,8 @@ pub struct Recheck {
     /// True when the tighter preset also gives no whirl at `lo` and whirl at `hi`.
     pub confirmed: bool,
     /// True when the bracket is not confirmed but the tighter preset's onset, searched again
-    /// (`relocated`), lies within the row's `tol_rpm` of the row's onset: the onset holds to
+    /// (`relocated`), lies within the row's `tol_rpm` of the row's onset, and the row is not
+    /// undecided: the onset holds to
     /// the tolerance the search was asked for, though a bracket end's class differs at the
     /// tighter preset (near an onset the class can flip within tens of r/min). Written only
     /// when true; absent reads as false.

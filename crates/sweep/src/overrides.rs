@@ -36,7 +36,7 @@ pub enum OverrideError {
     BadValue {
         /// The key as given.
         key: String,
-        /// What serde said.
+        /// What the field takes, in words, or serde's message (a section's, an enum's).
         reason: String,
     },
 }
@@ -177,42 +177,61 @@ fn get_value<'v>(root: &'v Value, key: &str) -> Option<&'v Value> {
     key.split('.').try_fold(root, |node, part| node.get(part))
 }
 
-/// Whether `value` at `key` makes a scene (of the right kind; its range is not checked).
+/// Whether `value` at `key` makes a scene as [`apply`] takes it (of the right kind, and no
+/// list read as a section by position; its range is not checked).
 fn parses(scene: &Scene, key: &str, value: Value) -> bool {
     let mut root = serde_json::to_value(scene).expect("a scene serialises");
-    set_value(&mut root, key, value).is_ok() && serde_json::from_value::<Scene>(root).is_ok()
+    if set_value(&mut root, key, value).is_err() {
+        return false;
+    }
+    serde_json::from_value::<Scene>(root.clone())
+        .is_ok_and(|parsed| whirlmap_core::json::check_objects(&root, &parsed).is_ok())
 }
 
 /// What a value of the wrong kind for `key` should have been, in the user's words, from the
-/// kinds the field takes (tried with a probe value, so an optional field absent at its
-/// default is covered too): `abc` is not a number, with the field's allowed range; `1.5` is
-/// not a whole number (a count); `maybe` is not true or false; `[1,x]` is not a list of 2 numbers, with an example. `None` for the
-/// other kinds (an enum's unknown variant, a section), whose serde message names the choices.
+/// kinds the field takes (tried with probe values through [`parses`], so an optional field
+/// absent at its default is covered too, and a section is never offered a list): `abc` is
+/// not a number, with the field's allowed range; `1.5` is not a whole number written in
+/// digits (a count); `maybe` is not true or false; `[1,x]` is not a list of 2 numbers, with
+/// an example; each saying when null is allowed too. `None` for the other kinds (a section,
+/// an enum's unknown variant), whose serde message names the known fields or the choices.
 fn wrong_type_reason(
     scene: &Scene,
     key: &str,
     before: Option<&Value>,
     shown: &str,
 ) -> Option<String> {
+    // A section keeps serde's message, which names an unknown field and the known ones.
+    if matches!(before, Some(Value::Object(_))) {
+        return None;
+    }
+    let or_null = if parses(scene, key, Value::Null) {
+        " (or null for none)"
+    } else {
+        ""
+    };
     if parses(scene, key, Value::from(0.0)) {
         return Some(format!(
-            "`{shown}` is not a number; allowed {}",
+            "`{shown}` is not a number{or_null}; allowed {}",
             finite_range(scene, key)
         ));
     }
     if parses(scene, key, Value::from(0_u64)) {
-        // A count: the validation's words for 0 give its range when 0 is not allowed.
+        // A count: the validation's words for 0 give its range when 0 is not allowed. JSON
+        // reads `1e6` and `2.0` as fractions, so the message asks for digits.
         let mut s = scene.clone();
         let allowed = match apply(&mut s, key, Value::from(0_u64)).map(|()| s.validate()) {
             Ok(Err(e)) if e.field == key => e.allowed,
             _ => ">= 0".to_string(),
         };
+        let example = before.map_or_else(|| "1000".to_string(), Value::to_string);
         return Some(format!(
-            "`{shown}` is not a whole number; allowed {allowed}"
+            "`{shown}` is not a whole number written in digits (e.g. `{example}`){or_null}; \
+             allowed {allowed}"
         ));
     }
     if parses(scene, key, Value::Bool(false)) {
-        return Some(format!("`{shown}` is not `true` or `false`"));
+        return Some(format!("`{shown}` is not `true` or `false`{or_null}"));
     }
     let example = match before {
         Some(Value::Array(items)) if items.iter().all(Value::is_number) => {
@@ -223,8 +242,9 @@ fn wrong_type_reason(
             .find(|v| parses(scene, key, v.clone()))?,
     };
     let n = example.as_array().map_or(0, Vec::len);
+    let numbers = if n == 1 { "number" } else { "numbers" };
     Some(format!(
-        "`{shown}` is not a list of {n} numbers; write it as `{example}`"
+        "`{shown}` is not a list of {n} {numbers}{or_null}; write it as `{example}`"
     ))
 }
 
@@ -401,15 +421,15 @@ mod tests {
             ),
             (
                 "solver.max_step_attempts=abc",
-                "`abc` is not a whole number; allowed >= 1",
+                "`abc` is not a whole number written in digits (e.g. `20000000`); allowed >= 1",
             ),
             (
                 "solver.max_step_attempts=1.5",
-                "`1.5` is not a whole number; allowed >= 1",
+                "`1.5` is not a whole number written in digits (e.g. `20000000`); allowed >= 1",
             ),
             (
                 "solver.max_step_attempts=-1",
-                "`-1` is not a whole number; allowed >= 1",
+                "`-1` is not a whole number written in digits (e.g. `20000000`); allowed >= 1",
             ),
             ("drag_enabled=maybe", "`maybe` is not `true` or `false`"),
             ("drag_enabled=1", "`1` is not `true` or `false`"),
@@ -434,6 +454,28 @@ mod tests {
             );
         }
         assert_eq!(s, Scene::paper(), "nothing was set");
+        // An optional number says that null is allowed too.
+        let e = apply_assignment(&mut s, "stop_speed_rpm=slow")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`slow` is not a number (or null for none); allowed"),
+            "{e}"
+        );
+        // A section, present or absent, keeps serde's message: it is never offered a list
+        // (serde would read one by position), and a misspelt key inside it is named.
+        for (set, says) in [
+            ("solver=abc", "expected struct SolverSettings"),
+            ("thermal=abc", "expected struct ThermalParams"),
+            (r#"solver={"rtoll":1e-6}"#, "unknown field `rtoll`"),
+            (
+                r#"thermal={"macro_stp_s":1e-3}"#,
+                "unknown field `macro_stp_s`",
+            ),
+        ] {
+            let e = apply_assignment(&mut s, set).unwrap_err().to_string();
+            assert!(e.contains(says) && !e.contains("list of"), "{set}: {e}");
+        }
         // An enum keeps serde's message, which lists the choices.
         let e = apply_assignment(&mut s, "solver.method=fast")
             .unwrap_err()

@@ -40,7 +40,7 @@ pub fn recheck_bracket(
 
 /// Re-checks every row's bracket ([`recheck_bracket`]) at `tighter`, the rows at once, each
 /// on `base` with the row's friction coefficient, and records each in its row
-/// ([`Recheck::apply_to`]: an unconfirmed bracket leaves the row not converged). With `cancel`, a drop not yet started
+/// ([`Recheck::apply_to`]: an onset that does not hold there leaves the row not converged). With `cancel`, a drop not yet started
 /// when it is raised is skipped (its outcome "cancelled"; the caller discards the rows)
 /// and every drop run is counted on it. Every drop run ticks `ticker`, which expects the
 /// brackets' two drops each, and a window search's as it plans them.
@@ -106,7 +106,8 @@ fn recheck_with(
         within_tol: false,
         relocated,
     };
-    rc.within_tol = !confirmed && rc.onset_within(row.onset_rpm, row.tol_rpm);
+    // An undecided onset is no onset to hold: failed drops could move it.
+    rc.within_tol = !confirmed && !row.undecided && rc.onset_within(row.onset_rpm, row.tol_rpm);
     Some(rc)
 }
 
@@ -391,6 +392,14 @@ mod tests {
         // A confirmed bracket is not marked within the tolerance: it needs no window.
         let (rc, _) = recheck(4321.0, 4321.0, &[]);
         assert!(rc.confirmed && !rc.within_tol);
+        // An undecided row's onset does not hold, however close the tighter preset's is.
+        let mut r = row(4321.0);
+        r.undecided = true;
+        let run = |_: &Scene, speed: f64| class_at(4318.0, speed);
+        let rc = recheck_with(&Scene::paper(), &r, Fidelity::Standard, &run, None).unwrap();
+        let found = rc.relocated.as_ref().and_then(|w| w.onset_rpm);
+        assert_eq!(found, Some(4320.3125));
+        assert!(!rc.within_tol && !rc.holds(), "{rc:?}");
     }
 
     /// A bracket end the window meets again, as a scan point (an end on the lattice) or as a

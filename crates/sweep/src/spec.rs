@@ -224,7 +224,8 @@ pub struct CriticalSpec {
     pub tol_rpm: f64,
     /// Re-check each onset bracket at the next tighter preset than the sweep's `fidelity`
     /// (which must be `draft` or `standard`), as `whirlmap critical --fidelity` does: the row
-    /// records it as `recheck`, and a bracket the tighter preset does not confirm leaves it
+    /// records it as `recheck`, and an onset that does not hold there (a bracket the tighter
+    /// preset does not confirm, and its onset not found again within `tol_rpm`) leaves it
     /// not converged ([`crate::recheck`]). Default false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub recheck: bool,
