@@ -499,6 +499,7 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
         Method::Ros34pw2 => run_with(scene, opts, extra, sys, Ros34pw2::new(ctl)),
         Method::Rodas4 => run_with(scene, opts, extra, sys, Rodas4::new(ctl)),
         Method::Rodas5p => run_with(scene, opts, extra, sys, Rodas5p::new(ctl)),
+        Method::Radau5 => run_with(scene, opts, extra, sys, crate::ode::Radau5::new(ctl)),
     }
 }
 

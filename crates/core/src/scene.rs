@@ -50,6 +50,9 @@ pub enum Method {
     /// Rodas5P, a Rosenbrock method of order 5 (Steinebach 2023) on the full Jacobian and
     /// the factors of RODAS4 (`ode/rodas5p.rs`).
     Rodas5p,
+    /// RADAU5, the 3-stage Radau IIA collocation method of order 5 (Hairer and Wanner) on
+    /// the full Jacobian, with a simplified Newton iteration (`ode/radau5.rs`).
+    Radau5,
 }
 
 impl Method {
@@ -57,7 +60,7 @@ impl Method {
     /// Jacobian (every term: the energy integrals' rows, the sticking constraint's slopes, the
     /// drag's), rather than a W-method's stiff approximation or none.
     pub fn needs_exact_jacobian(self) -> bool {
-        matches!(self, Method::Rodas4 | Method::Rodas5p)
+        matches!(self, Method::Rodas4 | Method::Rodas5p | Method::Radau5)
     }
 }
 
@@ -109,7 +112,9 @@ pub struct SolverSettings {
     /// fidelity's); `dopri5`, the explicit Dormand-Prince 5(4) pair (the `reference`
     /// fidelity's); `ros34pw2`, the 3rd-order Rosenbrock-W method (the `draft` fidelity's);
     /// `dop853` the independent reference of `whirlmap accuracy`; `rodas5p`, the 5th-order
-    /// Rosenbrock method on RODAS4's Jacobian, for errors below about 1e-5 (docs/accuracy.md).
+    /// Rosenbrock method on RODAS4's Jacobian, for errors below about 1e-5 (docs/accuracy.md);
+    /// `radau5`, the 5th-order Radau IIA collocation method on the same Jacobian, about half
+    /// of RODAS4's steps on a pendulum drop at a higher cost per step (docs/performance.md).
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a

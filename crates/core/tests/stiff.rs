@@ -282,7 +282,12 @@ fn drop_with(method: whirlmap_core::Method, rtol: f64, gap: bool) -> whirlmap_co
 #[test]
 fn implicit_steppers_converge_to_the_reference_on_a_bouncing_drop() {
     let reference = drop_with(Method::Dopri5, 1e-9, false);
-    for method in [Method::Ros34pw2, Method::Rodas4, Method::Rodas5p] {
+    for method in [
+        Method::Ros34pw2,
+        Method::Rodas4,
+        Method::Rodas5p,
+        Method::Radau5,
+    ] {
         converges_to(&reference, method);
     }
 }
