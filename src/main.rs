@@ -152,8 +152,8 @@ enum Command {
     /// Print the JSON Schema of a scene, sweep or ensemble file, for editors to validate
     /// files against: type, default, unit, allowed range and source of every scene field.
     Schema(SchemaArgs),
-    /// Time eleven reference drops (pendulum and whirl drops at the fidelity presets, model
-    /// variants, a high speed, RODAS4 against Rodas5P at a tight tolerance) and one
+    /// Time fourteen reference drops (pendulum and whirl drops at the fidelity presets, model
+    /// variants, a high speed, RODAS4 against Rodas5P at a tight tolerance, RADAU5) and one
     /// right-hand-side evaluation.
     Bench(bench::BenchArgs),
     /// Draw the design charts (Figs. 3-6, class map) of a sweep's results directory into
