@@ -93,6 +93,33 @@ impl<const N: usize> StepCore<N> {
             .unwrap_or(self.ctl.atol);
     }
 
+    /// Records the accepted step from `(t, y)` to `(t + h, y1)` with derivatives `f_start` and
+    /// `f1` at its ends: its interpolant, the cubic Hermite one of the ends (as the implicit
+    /// steppers without their own give it), and one more step counted.
+    pub(super) fn hermite_end(
+        &mut self,
+        t: f64,
+        h: f64,
+        y: &[f64; N],
+        y1: [f64; N],
+        f_start: &[f64; N],
+        f1: &[f64; N],
+    ) -> &Dense<N> {
+        let d = &mut self.dense;
+        let r = &mut d.r;
+        for i in 0..N {
+            let ydiff = y1[i] - y[i];
+            let bspl = h * f_start[i] - ydiff;
+            r[0][i] = y[i];
+            r[1][i] = ydiff;
+            r[2][i] = bspl;
+            r[3][i] = ydiff - h * f1[i] - bspl;
+        }
+        (d.t0, d.h, d.t_end, d.terms, d.y1) = (t, h, t + h, 5, y1);
+        self.stats.steps += 1;
+        &self.dense
+    }
+
     /// Cuts the last accepted step at `t_cut` and returns its interpolant.
     pub(super) fn cut_last_step(&mut self, t_cut: f64) -> &Dense<N> {
         self.dense.t_end = t_cut;

@@ -469,20 +469,8 @@ impl<const N: usize> Stepper<N> for Radau5<N> {
         let mut f1 = [0.0; N];
         sys.rhs(t + h, &y1, &mut f1);
         self.core.stats.rhs_evals += 1;
-        let d = &mut self.core.dense;
-        let r = &mut d.r;
-        for i in 0..N {
-            let ydiff = y1[i] - y[i];
-            let bspl = h * f0[i] - ydiff;
-            r[0][i] = y[i];
-            r[1][i] = ydiff;
-            r[2][i] = bspl;
-            r[3][i] = ydiff - h * f1[i] - bspl;
-        }
-        (d.t0, d.h, d.t_end, d.terms, d.y1) = (t, h, t + h, 5, y1);
         self.f0 = f1;
-        self.core.stats.steps += 1;
-        Ok(&self.core.dense)
+        Ok(self.core.hermite_end(t, h, y, y1, &f0, &f1))
     }
 
     fn core(&self) -> &StepCore<N> {

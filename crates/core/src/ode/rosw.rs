@@ -476,31 +476,23 @@ where
     let mut f1 = [0.0; N];
     sys.rhs(t + h, &y1, &mut f1);
     core.stats.rhs_evals += 1;
+    *f0 = f1;
+    if !method.own_dense {
+        return Ok(core.hermite_end(t, h, y, y1, &start, &f1));
+    }
     let d = &mut core.dense;
     let r = &mut d.r;
-    if method.own_dense {
-        // In the nested form: r2 = K1, r3 = K2 + K3, r4 = -K3 (rows 5-7 hold K1..K3, from the
-        // accepted attempt, the last one).
-        for i in 0..N {
-            let (k1, k2, k3) = (r[5][i], r[6][i], r[7][i]);
-            r[0][i] = y[i];
-            r[1][i] = y1[i] - y[i];
-            r[2][i] = k1;
-            r[3][i] = k2 + k3;
-            r[4][i] = -k3;
-        }
-    } else {
-        for i in 0..N {
-            let ydiff = y1[i] - y[i];
-            let bspl = h * start[i] - ydiff;
-            r[0][i] = y[i];
-            r[1][i] = ydiff;
-            r[2][i] = bspl;
-            r[3][i] = ydiff - h * f1[i] - bspl;
-        }
+    // In the nested form: r2 = K1, r3 = K2 + K3, r4 = -K3 (rows 5-7 hold K1..K3, from the
+    // accepted attempt, the last one).
+    for i in 0..N {
+        let (k1, k2, k3) = (r[5][i], r[6][i], r[7][i]);
+        r[0][i] = y[i];
+        r[1][i] = y1[i] - y[i];
+        r[2][i] = k1;
+        r[3][i] = k2 + k3;
+        r[4][i] = -k3;
     }
     (d.t0, d.h, d.t_end, d.terms, d.y1) = (t, h, t + h, 5, y1);
-    *f0 = f1;
     core.stats.steps += 1;
     Ok(&core.dense)
 }
