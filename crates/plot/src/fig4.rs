@@ -473,11 +473,21 @@ mod tests {
     /// `tag`, kept (and named on standard error) when `WHIRLMAP_KEEP_CHART` is set, to be
     /// looked at.
     fn drawn(rows: &[CriticalRow], tag: &str, title: &str) -> Vec<u8> {
+        drawn_with_band(rows, None, tag, title)
+    }
+
+    /// [`drawn`] with a probability band.
+    fn drawn_with_band(
+        rows: &[CriticalRow],
+        band: Option<&[BandPoint]>,
+        tag: &str,
+        title: &str,
+    ) -> Vec<u8> {
         let path =
             std::env::temp_dir().join(format!("whirlmap-fig4-{tag}-{}.png", std::process::id()));
         let fig = Fig4 {
             rows,
-            band: None,
+            band: band.map(|b| (b, "(test)".to_string())),
             title: title.into(),
         };
         crate::render::render(&path, (1000, 700), &fig).unwrap();
@@ -624,23 +634,7 @@ mod tests {
         ];
         let mut closed = clipped;
         closed[0].reached[2] = true;
-        let draw = |band: &[BandPoint], tag: &str| {
-            let path = std::env::temp_dir()
-                .join(format!("whirlmap-fig4-{tag}-{}.png", std::process::id()));
-            let fig = Fig4 {
-                rows: &rows,
-                band: Some((band, "(test)".into())),
-                title: tag.into(),
-            };
-            crate::render::render(&path, (1000, 700), &fig).unwrap();
-            let bytes = std::fs::read(&path).unwrap();
-            if std::env::var_os("WHIRLMAP_KEEP_CHART").is_some() {
-                eprintln!("chart: {}", path.display());
-            } else {
-                std::fs::remove_file(&path).ok();
-            }
-            bytes
-        };
+        let draw = |band: &[BandPoint], tag: &str| drawn_with_band(&rows, Some(band), tag, tag);
         assert_ne!(draw(&clipped, "band-open"), draw(&closed, "band-closed"));
         assert_eq!(clipped_levels(&clipped), "90 %");
         let mut none_at_50 = clipped;
