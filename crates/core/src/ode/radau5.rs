@@ -198,7 +198,7 @@ pub struct Radau5<const N: usize> {
     /// The Newton iteration's contraction estimate `theta / (1 - theta)`, carried over.
     faccon: f64,
     /// A cap on the step from the last Newton failure, grown by [`NEWTON_CAP_GROWTH`] at
-    /// every step without one.
+    /// every step without one; none after a restart or on fixed steps.
     h_newton: f64,
     /// Newton iterations, over every attempt.
     newton_iterations: u64,
@@ -303,10 +303,13 @@ impl<const N: usize> Radau5<N> {
         let mut w = stage_mix(&TI, &z);
         let rtol = core.ctl.rtol;
         // RADAU5's stopping tolerance of the iteration, against the error scale; on fixed
-        // steps (no error control) the iteration runs to rounding instead, so that the
-        // solution is the collocation method's.
+        // steps (no error control) the iteration runs down to rounding instead (at most
+        // `eps / rtol` in that scale), so that the solution is the collocation method's.
         let (fnewt, nit) = if core.ctl.fixed_step.is_some() {
-            (1e3 * f64::EPSILON, 4 * NIT)
+            (
+                (10.0 * f64::EPSILON / rtol).max(1e3 * f64::EPSILON),
+                4 * NIT,
+            )
         } else {
             (
                 (10.0 * f64::EPSILON / rtol).max(0.03_f64.min(rtol.sqrt())),
@@ -408,7 +411,10 @@ impl<const N: usize> Stepper<N> for Radau5<N> {
     fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
         sys.rhs(t, y, &mut self.f0);
         self.core.restart(sys, y, &self.f0);
+        // A new mode: no collocation polynomial to start from, and no Newton cap from the
+        // old one (the driver caps the first step of a mode itself).
         self.last = None;
+        self.h_newton = f64::INFINITY;
     }
 
     fn step<S: OdeSystem<N>>(
@@ -430,7 +436,9 @@ impl<const N: usize> Stepper<N> for Radau5<N> {
         let mut h_newton = self.h_newton;
         let mut failed = false;
         let mut rejected = false;
-        let (z, h) = self.core.control(&LAW, t, h_cap.min(h_newton), |core, h| {
+        let fixed = self.core.ctl.fixed_step.is_some();
+        let h_cap = if fixed { h_cap } else { h_cap.min(h_newton) };
+        let (z, h) = self.core.control(&LAW, t, h_cap, |core, h| {
             let start = starting_stages(last.as_ref(), h);
             let refine = last.is_none() || rejected;
             rejected = true;
@@ -452,8 +460,11 @@ impl<const N: usize> Stepper<N> for Radau5<N> {
                     failed = true;
                     faccon = 1.0;
                     h_newton = h * cut;
-                    // The step times `cut` (LAW: h / (err^(1/4) / 0.9)).
-                    ([[f64::NAN; N]; 3], (0.9 / cut).powi(4))
+                    // The step times `cut` (LAW: h / (err^(1/4) / 0.9)); on a fixed step, which
+                    // control() accepts whatever a finite error, a non-finite one, which it
+                    // refuses (NonFiniteState).
+                    let err = if fixed { f64::NAN } else { (0.9 / cut).powi(4) };
+                    ([[f64::NAN; N]; 3], err)
                 }
             }
         })?;
@@ -484,6 +495,47 @@ impl<const N: usize> Stepper<N> for Radau5<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ode::{integrate, NoObserver};
+
+    /// `y' = -1e6 (y - cos t)` with no Jacobian given: the simplified Newton iteration is then
+    /// a fixed-point one, which diverges once `h 1e6` passes about 1.
+    struct Relax;
+    impl OdeSystem<1> for Relax {
+        type Guard = crate::ode::NoGuard;
+        fn rhs(&self, t: f64, y: &[f64; 1], dy: &mut [f64; 1]) {
+            dy[0] = -1e6 * (y[0] - t.cos());
+        }
+    }
+
+    /// A Newton iteration that fails on a fixed step is an error, never a state of NaN taken
+    /// as the step's end; with error control the step shrinks until it converges, and the
+    /// solution follows `cos t`.
+    #[test]
+    fn a_newton_failure_on_a_fixed_step_is_an_error() {
+        let ctl = |fixed_step| StepControl {
+            rtol: 1e-6,
+            atol: [1e-9],
+            h_min: 1e-14,
+            max_attempts: 1_000_000,
+            fixed_step,
+        };
+        let (mut t, mut y) = (0.0, [1.0]);
+        let e = integrate(
+            &Relax,
+            &mut Radau5::new(ctl(Some(1e-3))),
+            &mut t,
+            &mut y,
+            0.01,
+            &mut NoObserver,
+        )
+        .unwrap_err();
+        assert!(matches!(e, SolveError::NonFiniteState { .. }), "{e:?}");
+        let (mut t, mut y) = (0.0, [1.0]);
+        let mut st = Radau5::new(ctl(None));
+        integrate(&Relax, &mut st, &mut t, &mut y, 0.01, &mut NoObserver).unwrap();
+        assert!((y[0] - 0.01_f64.cos()).abs() < 1e-6, "{}", y[0]);
+        assert!(st.stats().rejected > 0 && st.newton_iterations() > 0);
+    }
 
     /// The two shifted solves against the full 15 x 15 system `c I - J` (coupled block with
     /// four kinematic rows, quadrature rows, uncoupled components), for a real shift through
