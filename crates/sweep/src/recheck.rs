@@ -40,9 +40,9 @@ pub fn recheck_bracket(
 
 /// Re-checks every row's bracket ([`recheck_bracket`]) at `tighter`, the rows at once, each
 /// on `base` with the row's friction coefficient, and records each in its row
-/// ([`Recheck::apply_to`]: an onset that does not hold there leaves the row not converged). With `cancel`, a drop not yet started
-/// when it is raised is skipped (its outcome "cancelled"; the caller discards the rows)
-/// and every drop run is counted on it. Every drop run ticks `ticker`, which expects the
+/// ([`Recheck::apply_to`]: an onset that does not hold there leaves the row not converged).
+/// With `cancel`, a drop not yet started when it is raised is skipped (its outcome
+/// "cancelled"; the caller discards the rows) and every drop run is counted on it. Every drop run ticks `ticker`, which expects the
 /// brackets' two drops each, and a window search's as it plans them.
 pub fn recheck_rows(
     base: &Scene,
