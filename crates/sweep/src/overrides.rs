@@ -148,18 +148,21 @@ fn finite_range(scene: &Scene, key: &str) -> String {
 /// Sets the scene parameter `key` (dotted for nested fields) to `value`.
 pub fn apply(scene: &mut Scene, key: &str, value: Value) -> Result<(), OverrideError> {
     let mut root = serde_json::to_value(&*scene).expect("a scene serialises");
-    let before = get_value(&root, key).cloned();
-    let shown = match &value {
-        Value::String(text) => text.clone(),
-        other => other.to_string(),
-    };
     set_value(&mut root, key, value)?;
-    let parsed: Scene =
-        serde_json::from_value(root.clone()).map_err(|e| OverrideError::BadValue {
+    let parsed: Scene = serde_json::from_value(root.clone()).map_err(|e| {
+        // Only on the way out: the value given and the scene's own at `key` (unchanged).
+        let shown = match get_value(&root, key) {
+            Some(Value::String(text)) => text.clone(),
+            Some(other) => other.to_string(),
+            None => String::new(),
+        };
+        let before = serde_json::to_value(&*scene).expect("a scene serialises");
+        OverrideError::BadValue {
             key: key.to_string(),
-            reason: wrong_type_reason(scene, key, before.as_ref(), &shown)
+            reason: wrong_type_reason(scene, key, get_value(&before, key), &shown)
                 .unwrap_or_else(|| e.to_string()),
-        })?;
+        }
+    })?;
     // A list where the scene has an object would be read by position.
     whirlmap_core::json::check_objects(&root, &parsed).map_err(|reason| {
         OverrideError::BadValue {

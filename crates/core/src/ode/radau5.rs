@@ -130,7 +130,6 @@ impl ComplexLu {
         let m = n - k;
         let idx = &j.idx;
         let ci = c.inv();
-        let mut coupled = [false; N];
         let mut x = [C64::new(0.0, 0.0); MAX_STIFF];
         let mut rq = [C64::new(0.0, 0.0); MAX_STIFF];
         for b in 0..k {
@@ -163,24 +162,21 @@ impl ComplexLu {
         for b in 0..k {
             x[b] = (rq[b] + x[k + b]) * ci;
         }
-        for a in 0..n {
-            coupled[idx[a]] = true;
+        // Every component `r / c` (the uncoupled ones' answer), then the quadratures and the
+        // coupled components over it.
+        let r0 = *r;
+        for v in r.iter_mut() {
+            *v *= ci;
         }
         for a in 0..j.quad_len {
-            let mut s = r[j.quad_idx[a]];
+            let mut s = r0[j.quad_idx[a]];
             for b in 0..n {
                 s += x[b] * j.quad[(a, b)];
             }
             r[j.quad_idx[a]] = s * ci;
-            coupled[j.quad_idx[a]] = true;
         }
         for a in 0..n {
             r[idx[a]] = x[a];
-        }
-        for i in 0..N {
-            if !coupled[i] {
-                r[i] *= ci;
-            }
         }
     }
 }
@@ -435,13 +431,14 @@ impl<const N: usize> Stepper<N> for Radau5<N> {
         let (mut faccon, mut newton) = (self.faccon, 0);
         let mut h_newton = self.h_newton;
         let mut failed = false;
-        let mut rejected = false;
+        let mut tried = false;
         let fixed = self.core.ctl.fixed_step.is_some();
         let h_cap = if fixed { h_cap } else { h_cap.min(h_newton) };
         let (z, h) = self.core.control(&LAW, t, h_cap, |core, h| {
             let start = starting_stages(last.as_ref(), h);
-            let refine = last.is_none() || rejected;
-            rejected = true;
+            // RADAU5 refines the error estimate on the first step and after a rejection.
+            let refine = last.is_none() || tried;
+            tried = true;
             match Self::attempt(
                 core,
                 &mut lu,
