@@ -27,7 +27,7 @@ pub struct AccuracyArgs {
     #[arg(long)]
     overwrite: bool,
     /// Worker threads (1 gives the cleanest wall times); default 1.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=crate::MAX_THREADS as i64))]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = crate::flags::threads)]
     threads: u32,
     /// Run no drops: draw the charts again from the `study.json` already in --out (the study
     /// of --cases), replacing only the charts.

@@ -16,10 +16,20 @@ pub struct CompareArgs {
     /// The new results folder.
     new: PathBuf,
     /// Relative change of the maximum contact force that counts as changed.
-    #[arg(long, allow_negative_numbers = true, default_value_t = Thresholds::default().force_rel)]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        default_value_t = Thresholds::default().force_rel,
+        value_parser = crate::flags::number(crate::flags::threshold_range)
+    )]
     force_rel: f64,
     /// Relative change of the peak heat power that counts as changed.
-    #[arg(long, allow_negative_numbers = true, default_value_t = Thresholds::default().power_rel)]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        default_value_t = Thresholds::default().power_rel,
+        value_parser = crate::flags::number(crate::flags::threshold_range)
+    )]
     power_rel: f64,
     /// The Markdown report; the class map goes beside it as `<stem>-classes.png`. Default
     /// NEW/compare.md.

@@ -14,7 +14,7 @@
 //! holds ([`DropLog::open_kept`]): a killed search run again does only what is missing, and
 //! the rows are those of an uninterrupted run (each is a function of its drops' classes).
 
-use crate::{build_scene, CmdResult, Done, Failure};
+use crate::{build_scene, flags, CmdResult, Done, Failure};
 use std::path::PathBuf;
 use std::time::Instant;
 use whirlmap_core::InvalidParameter;
@@ -34,26 +34,52 @@ pub struct CriticalArgs {
         long,
         value_delimiter = ',',
         required = true,
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        value_parser = flags::number(flags::critical_mu_range)
     )]
     mu: Vec<f64>,
     /// Lowest release speed searched (r/min), in [0, 1e6).
-    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 1000.0,
+        allow_negative_numbers = true,
+        value_parser = flags::number(flags::from_range)
+    )]
     from: f64,
     /// Highest release speed searched (r/min), in (--from, 1e6].
-    #[arg(long, default_value_t = 30000.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 30000.0,
+        allow_negative_numbers = true,
+        value_parser = flags::number(flags::to_range)
+    )]
     to: f64,
     /// Lattice step of the scan (r/min): every multiple of it in the range is dropped,
     /// whatever the range ends, so the onset does not depend on the range.
-    #[arg(long, default_value_t = DEFAULT_RESOLUTION_RPM, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = DEFAULT_RESOLUTION_RPM,
+        allow_negative_numbers = true,
+        value_parser = flags::number(flags::resolution_range)
+    )]
     resolution_rpm: f64,
     /// Bisect every transition until its bracket is this narrow (r/min), at most the
     /// resolution.
-    #[arg(long, default_value_t = DEFAULT_TOL_RPM, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = DEFAULT_TOL_RPM,
+        allow_negative_numbers = true,
+        value_parser = flags::number(flags::tol_range)
+    )]
     tol_rpm: f64,
     /// Simulated time of each drop (s); a drop whose class has not settled by then is
     /// extended (scene `classification.max_extension_s`).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        allow_negative_numbers = true,
+        value_parser = flags::number(flags::duration_range)
+    )]
     duration_s: f64,
     /// Scene file (JSON); any subset of the fields printed by `whirlmap scene`.
     #[arg(long)]

@@ -26,7 +26,7 @@ pub struct EnsembleArgs {
     #[arg(long)]
     overwrite: bool,
     /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::MAX_THREADS as i64))]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::flags::threads)]
     pub(crate) threads: Option<u32>,
     /// No progress lines.
     #[arg(long)]

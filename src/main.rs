@@ -6,6 +6,7 @@
 
 #[macro_use]
 mod output;
+mod flags;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
@@ -186,10 +187,10 @@ enum Command {
 struct DropArgs {
     /// Rotor speed at release (r/min), in [-1e6, 1e6] (negative: spinning the other way);
     /// default: the scene's (8000).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = flags::number(flags::speed_range))]
     speed_rpm: Option<f64>,
     /// Dynamic friction coefficient rotor-race, [0, 2]; default: the scene's (0.1).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = flags::number(flags::mu_range))]
     mu: Option<f64>,
     /// Scene file (JSON); any subset of the fields printed by `whirlmap scene`.
     #[arg(long)]
@@ -198,7 +199,12 @@ struct DropArgs {
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
     /// Simulated time after release (s).
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        allow_negative_numbers = true,
+        value_parser = flags::number(flags::duration_range)
+    )]
     duration_s: f64,
     /// Print the JSON record instead of a summary.
     #[arg(long)]

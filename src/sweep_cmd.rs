@@ -30,7 +30,7 @@ pub struct SweepArgs {
     #[arg(long)]
     pub(crate) out: Option<PathBuf>,
     /// Worker threads; default: rayon's (RAYON_NUM_THREADS or the number of cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=crate::MAX_THREADS as i64))]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::flags::threads)]
     pub(crate) threads: Option<u32>,
     /// Continue the run in the output folder: keep its ok points, its finished critical
     /// search, orbits and probability members, and run only the rest. Only a run of the same
@@ -48,10 +48,10 @@ pub struct SweepArgs {
     /// Run only shard I of --shards N (0 <= I < N): grid points, critical searches and orbit
     /// panels whose position mod N is I; default --out `results/<name>/shard-I-of-N`. Join the
     /// shards with `whirlmap merge`.
-    #[arg(long, requires = "shards", value_name = "I")]
+    #[arg(long, requires = "shards", value_name = "I", allow_negative_numbers = true, value_parser = crate::flags::shard)]
     shard: Option<usize>,
     /// The number of shards (see --shard).
-    #[arg(long, requires = "shard", value_name = "N")]
+    #[arg(long, requires = "shard", value_name = "N", allow_negative_numbers = true, value_parser = crate::flags::shards)]
     shards: Option<usize>,
 }
 

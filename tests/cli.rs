@@ -123,6 +123,15 @@ fn bad_input_exits_2_naming_field_value_and_range() {
         (&["--mu", "NaN"], &["mu_dynamic", "NaN"]),
         (&["--duration-s", "0"], &["duration_s", "0", "(0, 3600]"]),
         (&["--duration-s", "-1"], &["duration_s", "-1"]),
+        (&["--mu", "abc"], &["--mu", "abc", "not a number", "[0, 2]"]),
+        (
+            &["--speed-rpm", "fast"],
+            &["--speed-rpm", "fast", "[-1e6, 1e6] r/min"],
+        ),
+        (
+            &["--duration-s", "1s"],
+            &["--duration-s", "1s", "(0, 3600] s"],
+        ),
         (
             &["--set", "rotor_mass_kg=0"],
             &["rotor_mass_kg", "0", "[1e-3, 1e6] kg"],
@@ -458,4 +467,50 @@ fn a_thread_count_from_the_environment_beyond_the_range_is_refused() {
     assert_eq!(o.status.code(), Some(0), "{}", out(&o));
     let o = run(&["scene"]);
     assert_eq!(o.status.code(), Some(0), "{}", out(&o));
+}
+
+/// A number flag given text of the wrong kind is refused (exit 2) naming the flag, the text and
+/// the flag's allowed range, before any work; a bound another flag sets is named by that flag.
+#[test]
+fn number_flags_given_text_name_their_range() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["critical", "--mu", "0.1,x"],
+            "'x' for '--mu <MU>': not a number; allowed [0, 2]",
+        ),
+        (
+            &["critical", "--mu", "0.1", "--from", "low"],
+            "'low' for '--from <FROM>': not a number; allowed [0, 1e6) r/min",
+        ),
+        (
+            &["critical", "--mu", "0.1", "--to", "high"],
+            "not a number; allowed (--from, 1e6] r/min",
+        ),
+        (
+            &["critical", "--mu", "0.1", "--tol-rpm", "fine"],
+            "not a number; allowed [0.01, --resolution-rpm] r/min",
+        ),
+        (
+            &["sweep", "sweeps/paper.json", "--threads", "two"],
+            "'two' for '--threads <THREADS>': not a whole number; allowed [1, 4096]",
+        ),
+        (
+            &["sweep", "sweeps/paper.json", "--threads", "-1"],
+            "not a whole number; allowed [1, 4096]",
+        ),
+        (
+            &["sweep", "sweeps/paper.json", "--threads", "0"],
+            "0 is out of range; allowed [1, 4096]",
+        ),
+        (
+            &["compare", "a", "b", "--force-rel", "tight"],
+            "'tight' for '--force-rel <FORCE_REL>': not a number; allowed [0, inf)",
+        ),
+    ];
+    for (args, needle) in cases {
+        let o = whirlmap(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", out(&o));
+        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+        assert!(o.stdout.is_empty(), "{args:?} ran: {}", out(&o));
+    }
 }

@@ -130,7 +130,7 @@ pub fn apply_assignment(scene: &mut Scene, assignment: &str) -> Result<(), Overr
 /// The range [`Scene::validate`] allows for the number `key`, in its own words, found by
 /// setting the largest finite values of either sign; "a finite number" when the key is not a
 /// number or the validation says nothing of it.
-fn finite_range(scene: &Scene, key: &str) -> String {
+pub fn finite_range(scene: &Scene, key: &str) -> String {
     for extreme in [f64::MAX, -f64::MAX] {
         let mut s = scene.clone();
         if apply(&mut s, key, Value::from(extreme)).is_err() {
