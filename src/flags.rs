@@ -9,14 +9,17 @@ use whirlmap_sweep::compare::Thresholds;
 use whirlmap_sweep::critical::{check_mus, CriticalOptions};
 use whirlmap_sweep::shard::MAX_SHARDS;
 
-/// A clap value parser: a finite or infinite number (`1e3`, `-0.5`), else "not a number;
-/// allowed <range>" with the range `allowed` states.
+/// A clap value parser: a finite or infinite number (`1e3`, `-0.5`; `-0` reads as 0, so it
+/// is echoed and hashed as 0), else "not a number; allowed <range>" with the range `allowed`
+/// states.
 pub(crate) fn number(
     allowed: fn() -> String,
 ) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync + 'static {
     move |text: &str| {
         text.trim()
             .parse::<f64>()
+            // -0 + 0 is +0 (round to nearest); every other number is unchanged.
+            .map(|x| x + 0.0)
             .map_err(|_| format!("not a number; allowed {}", allowed()))
     }
 }
@@ -144,6 +147,8 @@ mod tests {
     fn text_that_is_not_a_number_is_refused_with_the_flags_range() {
         assert_eq!(number(mu_range)(" 0.25 "), Ok(0.25));
         assert_eq!(number(speed_range)("-3e3"), Ok(-3000.0));
+        let zero = number(mu_range)("-0").unwrap();
+        assert!(zero == 0.0 && zero.is_sign_positive());
         assert_eq!(
             number(mu_range)("abc").unwrap_err(),
             "not a number; allowed [0, 2]"
