@@ -22,6 +22,12 @@ pub(super) struct StepLaw {
     pub fac_min: f64,
     /// Largest growth of one accepted step (h_new <= fac_max h).
     pub fac_max: f64,
+    /// Gustafsson's predictive controller (Hairer-Wanner II, IV.8, as RADAU5 has it): after
+    /// the second accepted step since a restart, the next step is also at most
+    /// `h_acc / h * (err^2 / err_acc)^expo / safe` of the law's step, where `h_acc` and
+    /// `err_acc` are the previous accepted step and its norm (floored at 1e-2). It shortens
+    /// the step where the error grows from step to step, before a rejection does.
+    pub predictive: bool,
 }
 
 /// The state every adaptive stepper keeps besides its stages (see
@@ -36,6 +42,11 @@ pub struct StepCore<const N: usize> {
     pub(super) h: f64,
     /// The previous accepted error norm (PI memory; floored at 1e-4).
     pub(super) err_old: f64,
+    /// The previous accepted step (s) since the last restart, 0 if none: the predictive
+    /// controller's memory ([`StepLaw::predictive`]).
+    pub(super) h_acc: f64,
+    /// The previous accepted error norm, floored at 1e-2 (the predictive controller's).
+    pub(super) err_acc: f64,
     /// The interpolant of the last accepted step.
     pub(super) dense: Dense<N>,
     /// The absolute tolerances of the current step ([`StepCore::begin_step`]).
@@ -50,6 +61,8 @@ impl<const N: usize> StepCore<N> {
             stats: Stats::default(),
             h: 0.0,
             err_old: 1e-4,
+            h_acc: 0.0,
+            err_acc: 1e-2,
             step_atol: ctl.atol,
             dense: Dense {
                 t0: 0.0,
@@ -66,6 +79,7 @@ impl<const N: usize> StepCore<N> {
     /// initial step (Hairer's `hinit`, capped by the system's largest step).
     pub(super) fn restart<S: OdeSystem<N>>(&mut self, sys: &S, y: &[f64; N], dy: &[f64; N]) {
         self.stats.rhs_evals += 1;
+        self.h_acc = 0.0;
         if let Some(hf) = self.ctl.fixed_step {
             self.h = hf;
         } else if self.h == 0.0 {
@@ -164,8 +178,18 @@ impl<const N: usize> StepCore<N> {
                     } else {
                         self.err_old.powf(law.beta)
                     };
-                    let fac = (err.max(1e-10).powf(law.expo) / pi / law.safe)
+                    let mut fac = (err.max(1e-10).powf(law.expo) / pi / law.safe)
                         .clamp(1.0 / law.fac_max, 1.0 / law.fac_min);
+                    if law.predictive {
+                        if self.h_acc > 0.0 {
+                            let e2 = err.max(1e-10).powi(2) / self.err_acc;
+                            let gus = (self.h_acc / h * e2.powf(law.expo) / law.safe)
+                                .clamp(1.0 / law.fac_max, 1.0 / law.fac_min);
+                            fac = fac.max(gus);
+                        }
+                        self.h_acc = h;
+                        self.err_acc = err.max(1e-2);
+                    }
                     let mut h_new = h / fac;
                     if rejected_last {
                         h_new = h_new.min(h);
@@ -202,6 +226,7 @@ mod tests {
         beta: 0.0,
         fac_min: 0.2,
         fac_max: 6.0,
+        predictive: false,
     };
 
     fn core(max_attempts: u64, fixed_step: Option<f64>) -> StepCore<1> {
@@ -253,6 +278,35 @@ mod tests {
         let (_, h) = c.control(&LAW, 0.0, 1e-9, |_, _| ((), 0.5)).unwrap();
         assert_eq!(h, 1e-9);
         assert_eq!(c.h, h0);
+    }
+
+    #[test]
+    fn the_predictive_law_shortens_the_step_where_the_error_grows() {
+        let pred = StepLaw {
+            predictive: true,
+            ..LAW
+        };
+        let (mut plain, mut c) = (core(100, None), core(100, None));
+        // The first accepted step has no history: both laws agree.
+        for k in [&mut plain, &mut c] {
+            k.control(&pred, 0.0, 1.0, |_, _| ((), 0.1)).unwrap();
+        }
+        assert_eq!(c.h, plain.h);
+        // An error growing from 0.1 to 0.9 over a step grown 1.6-fold: the plain law shrinks
+        // the step by 0.9 / 0.9^(1/4), the predictive one further, to
+        // h 0.9 (h / h_acc) / (0.9^2 / 0.1)^(1/4).
+        let h1 = c.h;
+        let (_, h) = c.control(&pred, 0.0, 1.0, |_, _| ((), 0.9)).unwrap();
+        plain.control(&LAW, 0.0, 1.0, |_, _| ((), 0.9)).unwrap();
+        assert_eq!(h, h1);
+        let expected = h1 * 0.9 * (h1 / 1e-3) / 8.1f64.powf(0.25);
+        assert!((c.h / expected - 1.0).abs() < 1e-12, "{} {expected}", c.h);
+        assert!(c.h < plain.h, "{} {}", c.h, plain.h);
+        // With no history (a restart clears it) the next step follows the plain law.
+        c.h_acc = 0.0;
+        let h2 = c.h;
+        c.control(&pred, 0.0, 1.0, |_, _| ((), 0.5)).unwrap();
+        assert!((c.h / (h2 * 0.9 / 0.5f64.powf(0.25)) - 1.0).abs() < 1e-12);
     }
 
     #[test]

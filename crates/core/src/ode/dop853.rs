@@ -203,6 +203,7 @@ const LAW: StepLaw = StepLaw {
     beta: 0.0,
     fac_min: 0.333,
     fac_max: 6.0,
+    predictive: false,
 };
 
 /// `y + h * sum_j a[j] k[j]` over the first `s` stages.

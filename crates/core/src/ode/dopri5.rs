@@ -70,6 +70,7 @@ const LAW: StepLaw = StepLaw {
     beta: 0.04,
     fac_min: 0.2,
     fac_max: 10.0,
+    predictive: false,
 };
 
 impl<const N: usize> Dopri5<N> {

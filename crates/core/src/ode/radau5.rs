@@ -71,13 +71,16 @@ const TI: [[f64; 3]; 3] = [
     ],
 ];
 
-/// The error estimate is O(h^4): exponent 1/4, safety 0.9, step ratio in [1/5, 6].
+/// The error estimate is O(h^4): exponent 1/4, safety 0.9, step ratio in [1/5, 6], with
+/// RADAU5's predictive controller (on a stiff Van der Pol problem it cut the rejections from
+/// 66 to 12 at rtol 1e-6; docs/performance.md).
 const LAW: StepLaw = StepLaw {
     safe: 0.9,
     expo: 0.25,
     beta: 0.0,
     fac_min: 0.2,
     fac_max: 6.0,
+    predictive: true,
 };
 
 /// Most Newton iterations per attempt (RADAU5's default).

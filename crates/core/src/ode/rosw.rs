@@ -319,6 +319,7 @@ const LAW: StepLaw = StepLaw {
     beta: 0.0,
     fac_min: 0.2,
     fac_max: 6.0,
+    predictive: false,
 };
 
 impl<const N: usize> Ros34pw2<N> {
