@@ -99,8 +99,10 @@ pub struct CriticalArgs {
     /// or a wider range reuses the shared ones. The file is kept; delete it to start afresh.
     #[arg(long, value_name = "FILE")]
     log: Option<PathBuf>,
-    /// Fidelity preset (draft, standard, reference) for the search; the onset bracket is
-    /// then re-checked at the next tighter preset (recorded as `recheck`).
+    /// Fidelity preset (draft, standard, reference) for the search; the cells that decide
+    /// each row (its onset bracket; without one, the end of the range that decides it: the
+    /// top for "no whirl", the bottom for whirl from the start) are then re-checked at the
+    /// next tighter preset (recorded as `recheck`).
     #[arg(long)]
     fidelity: Option<whirlmap_core::Fidelity>,
     /// No progress (by default a bar on a terminal, a plain line every 5 s otherwise).
@@ -227,10 +229,19 @@ pub(crate) fn report_unconfirmed(rows: &[CriticalRow]) -> bool {
     let Some(list) = whirlmap_sweep::critical::unconfirmed_summary(rows) else {
         return false;
     };
+    let without_bracket = rows
+        .iter()
+        .any(|r| r.bracket_rpm.is_none() && r.recheck.as_ref().is_some_and(|rc| !rc.holds()));
+    let cells = if without_bracket {
+        "the cells re-run (the bracket's, or for a row without one the end of the range that \
+         decides it)"
+    } else {
+        "the bracket"
+    };
     errln!(
-        "error: the re-check at the next tighter preset does not confirm the onset at \
-         {list}; the onset at this preset is not to be trusted there: where the tighter \
-         preset puts it, searched at least two lattice steps either side of the bracket within the \
+        "error: the re-check at the next tighter preset does not confirm the onset at {list}; \
+         the answer at this preset is not to be trusted there: where the tighter preset puts \
+         the onset, searched at least two lattice steps either side of {cells} within the \
          searched range, is in the row"
     );
     true
@@ -329,14 +340,17 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                 whirlmap_sweep::critical::Outcome::Class(c) => c.name().to_string(),
                 whirlmap_sweep::critical::Outcome::Failed(e) => format!("failed ({e})"),
             };
+            let cells: Vec<String> = rc
+                .cells()
+                .map(|(speed, o)| format!("{}: {}", fmt_rpm(*speed), show(o)))
+                .collect();
             outln!(
-                "    recheck ({})   {}: {}, {}: {} -> {}",
+                "    recheck ({})   {} -> {}",
                 rc.fidelity,
-                fmt_rpm(rc.lo.0),
-                show(&rc.lo.1),
-                fmt_rpm(rc.hi.0),
-                show(&rc.hi.1),
-                if rc.confirmed {
+                cells.join(", "),
+                if rc.confirmed && r.bracket_rpm.is_none() {
+                    "confirmed".to_string()
+                } else if rc.confirmed {
                     "bracket confirmed".to_string()
                 } else if rc.within_tol {
                     format!("the onset holds to {} r/min", fmt_rpm(r.tol_rpm))

@@ -449,6 +449,82 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
     );
 }
 
+/// A row without an onset bracket is re-checked at the end of the range that decides it. At
+/// mu 0.25 `draft` puts the onset near 13 400 r/min, beyond a range that ends at 12 000, while
+/// `standard` puts it near 11 500, inside: the draft row's "no whirl in the range" is not
+/// confirmed (exit 1), and `standard`'s onset, searched again below the range top, is the one
+/// a `standard` search of the range finds. At mu 0.1 (no whirl at either preset) the range
+/// top confirms it; at mu 0.4 (whirl from 6000 r/min at both) the range bottom does.
+#[test]
+fn a_row_without_a_bracket_is_re_checked_at_the_end_that_decides_it() {
+    let args = [
+        "critical",
+        "--json",
+        "--mu",
+        "0.1,0.25,0.4",
+        "--from",
+        "6000",
+        "--to",
+        "12000",
+        "--resolution-rpm",
+        "1000",
+        "--tol-rpm",
+        "100",
+        "--no-progress",
+        "--fidelity",
+        "draft",
+    ];
+    let o = whirlmap(&args);
+    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    let rows: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
+    for r in 0..3 {
+        assert!(rows[r]["bracket_rpm"].is_null(), "{rows}");
+    }
+    // mu 0.1: no whirl, confirmed at the range top.
+    let rc = &rows[0]["recheck"];
+    assert_eq!(
+        rc["lo"],
+        serde_json::json!([12000.0, {"class": "pendulum"}]),
+        "{rc}"
+    );
+    assert!(rc.get("hi").is_none() && rc["confirmed"] == true, "{rc}");
+    assert_eq!(rows[0]["converged"], true, "{rows}");
+    // mu 0.4: whirl from the lowest speed, confirmed there.
+    let rc = &rows[2]["recheck"];
+    assert_eq!(rc["hi"][0], 6000.0, "{rc}");
+    assert!(rc.get("lo").is_none() && rc["confirmed"] == true, "{rc}");
+    // mu 0.25: draft finds no whirl; standard whirls at the range top.
+    let row = &rows[1];
+    assert!(row["onset_rpm"].is_null(), "{row}");
+    assert_eq!(row["recheck"]["lo"][0], 12000.0, "{row}");
+    assert_eq!(row["recheck"]["confirmed"], false, "{row}");
+    assert_eq!(row["converged"], false, "{row}");
+    let note = row["note"].as_str().expect("a note");
+    assert!(
+        note.starts_with("NOT CONFIRMED by the re-check at standard: 12000 r/min backward_whirl"),
+        "{note}"
+    );
+    assert!(
+        stderr(&o).contains("does not confirm the onset at mu 0.25 (at standard:"),
+        "{}",
+        stderr(&o)
+    );
+    let mut standard = args.to_vec();
+    standard.truncate(args.len() - 2);
+    standard[3] = "0.25";
+    let o = whirlmap(&standard);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let full: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
+    let onset = full[0]["onset_rpm"].as_f64().expect("an onset at standard");
+    assert!((6000.0..12000.0).contains(&onset), "{onset}");
+    assert_eq!(
+        row["recheck"]["relocated"]["onset_rpm"].as_f64(),
+        Some(onset),
+        "{row}"
+    );
+    assert!(note.contains("where the search found no whirl"), "{note}");
+}
+
 #[test]
 fn a_sweep_shard_and_merge_exit_1_when_a_critical_speed_is_undecided() {
     let dir = temp_dir("critical-undecided-sweep");

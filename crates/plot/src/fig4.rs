@@ -548,8 +548,8 @@ mod tests {
         let [lo, hi] = rows[i].bracket_rpm.expect("a bracket");
         let recheck = |confirmed: bool| Recheck {
             fidelity: Fidelity::Reference,
-            lo: (lo, Outcome::Class(OrbitClass::BackwardWhirl)),
-            hi: (hi, Outcome::Class(OrbitClass::BackwardWhirl)),
+            lo: Some((lo, Outcome::Class(OrbitClass::BackwardWhirl))),
+            hi: Some((hi, Outcome::Class(OrbitClass::BackwardWhirl))),
             confirmed,
             within_tol: false,
             relocated: None,

@@ -122,7 +122,8 @@ pub struct CriticalRow {
     pub scan: Vec<Probe>,
     /// The bisection drops, transition by transition in speed order, each in the order run.
     pub bisections: Vec<Probe>,
-    /// The onset bracket re-run at a tighter fidelity preset, when asked for.
+    /// The cells that decide the row (its onset bracket, or the end of the range) re-run at a
+    /// tighter fidelity preset, when asked for.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub recheck: Option<Recheck>,
 }
@@ -222,16 +223,25 @@ pub fn unconfirmed_summary(rows: &[CriticalRow]) -> Option<String> {
     (!list.is_empty()).then(|| list.join(", "))
 }
 
-/// The bracket cells of a search run again at a tighter fidelity preset.
+/// The cells that decide a search's answer, run again at a tighter fidelity preset: the
+/// onset bracket's two; for a row without a bracket, the end of the range that decides it
+/// (the highest speed scanned when it found no whirl, `lo`; the lowest when whirl starts
+/// there, `hi`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Recheck {
     /// The preset the cells were re-run at.
     pub fidelity: Fidelity,
-    /// Lower bracket speed (r/min) and its outcome at that preset.
-    pub lo: (f64, Outcome),
-    /// Upper bracket speed (r/min) and its outcome at that preset.
-    pub hi: (f64, Outcome),
-    /// True when the tighter preset also gives no whirl at `lo` and whirl at `hi`.
+    /// Lower bracket speed (r/min) and its outcome at that preset; for a row that found no
+    /// whirl, its highest speed scanned. Absent for a row whose whirl starts at the lowest
+    /// speed scanned.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lo: Option<(f64, Outcome)>,
+    /// Upper bracket speed (r/min) and its outcome at that preset; for a row whose whirl
+    /// starts at the lowest speed scanned, that speed. Absent for a row that found no whirl.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hi: Option<(f64, Outcome)>,
+    /// True when the tighter preset agrees at the cells re-run: a settled class other than
+    /// whirl at `lo` and whirl at `hi`, each where present.
     pub confirmed: bool,
     /// True when the bracket is not confirmed but the tighter preset's onset, searched again
     /// (`relocated`), lies within the row's `tol_rpm` of the row's onset, and the row is not
@@ -283,7 +293,12 @@ impl Recheck {
         matches!((found, onset_rpm), (Some(a), Some(b)) if (a - b).abs() <= tol_rpm)
     }
 
-    /// The two drops at the tighter preset, in words: `at standard: 13312.5 r/min
+    /// The cells re-run, lower first.
+    pub fn cells(&self) -> impl Iterator<Item = &(f64, Outcome)> {
+        self.lo.iter().chain(&self.hi)
+    }
+
+    /// The drops at the tighter preset, in words: `at standard: 13312.5 r/min
     /// backward_whirl, 13375 r/min backward_whirl` (a failed drop reads `failed`), then,
     /// when the onset was searched again there, the window's note ([`Relocated::note`]).
     pub fn outcomes(&self) -> String {
@@ -295,24 +310,21 @@ impl Recheck {
             Some(r) => format!("; {}", r.note),
             None => String::new(),
         };
-        format!(
-            "at {}: {} r/min {}, {} r/min {}{relocated}",
-            self.fidelity,
-            self.lo.0,
-            show(&self.lo.1),
-            self.hi.0,
-            show(&self.hi.1)
-        )
+        let cells: Vec<String> = self
+            .cells()
+            .map(|(speed, o)| format!("{speed} r/min {}", show(o)))
+            .collect();
+        format!("at {}: {}{relocated}", self.fidelity, cells.join(", "))
     }
 
-    /// Drops the re-check ran: the bracket's two and the window's.
+    /// Drops the re-check ran: its cells and the window's.
     pub fn drops(&self) -> usize {
-        2 + self.relocated.as_ref().map_or(0, |r| r.drops)
+        self.cells().count() + self.relocated.as_ref().map_or(0, |r| r.drops)
     }
 
     /// Records this re-check in `row`. One whose onset does not hold at the tighter preset
     /// ([`Recheck::holds`]) makes the row not converged (its onset is the search preset's
-    /// only) and puts `NOT CONFIRMED` and the two drops ([`Recheck::outcomes`]) in its note,
+    /// only) and puts `NOT CONFIRMED` and the drops ([`Recheck::outcomes`]) in its note,
     /// so that `critical.csv`, which has no re-check columns, says it too: at the head of the
     /// note, or after the note of an undecided row, which starts with `UNDECIDED`. One that
     /// holds only within the tolerance (`within_tol`) says so in the note, in the same place,
@@ -386,8 +398,8 @@ mod tests {
     fn recheck(confirmed: bool) -> Recheck {
         Recheck {
             fidelity: Fidelity::Standard,
-            lo: (13312.5, Outcome::Class(OrbitClass::BackwardWhirl)),
-            hi: (13375.0, Outcome::Failed("step_budget: x".into())),
+            lo: Some((13312.5, Outcome::Class(OrbitClass::BackwardWhirl))),
+            hi: Some((13375.0, Outcome::Failed("step_budget: x".into()))),
             confirmed,
             within_tol: false,
             relocated: None,

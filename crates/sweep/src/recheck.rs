@@ -1,11 +1,15 @@
-//! Re-checking a critical-speed bracket at a tighter fidelity preset.
+//! Re-checking a critical-speed search at a tighter fidelity preset.
 //!
 //! A search run at a cheap preset (say `draft`) brackets the whirl boundary with two drops.
 //! Those two cells decide the answer, so they are run again at the next tighter preset; the
 //! result says whether the tighter model agrees (non-whirl below, whirl above) and is
-//! recorded next to the bracket. When it does not agree, the search runs again at the
-//! tighter preset over at least two lattice steps either side of the bracket (within the range
-//! searched; up to sixteen), to say where that preset puts the onset ([`Relocated`]).
+//! recorded next to the bracket. A search without a bracket is decided by one end of its
+//! range: "no whirl in the range" by its highest speed, "whirl already at the lowest speed" by
+//! its lowest; that cell is run again the same way (a cheap preset can put an onset just
+//! beyond the range the tighter one puts inside it). When the tighter preset does not agree,
+//! the search runs again at it over at least two lattice steps either side of the cells
+//! (within the range searched; up to sixteen), to say where that preset puts the onset
+//! ([`Relocated`]).
 
 use crate::cancel::Cancel;
 use crate::critical::{
@@ -21,8 +25,9 @@ use whirlmap_core::{DropOptions, Fidelity, Scene};
 
 pub use whirlmap_results::critical::{Recheck, Relocated};
 
-/// Re-runs the onset bracket of `row` (searched on `scene`, whose `mu_dynamic` is set) at
-/// `tighter`, its two drops at once; `None` without a bracket.
+/// Re-runs the cells that decide `row` ([`deciding_cells`]; searched on `scene`, whose
+/// `mu_dynamic` is set) at `tighter`, at once; `None` when nothing was decided (every scan
+/// drop failed).
 pub fn recheck_bracket(
     scene: &Scene,
     row: &CriticalRow,
@@ -38,12 +43,13 @@ pub fn recheck_bracket(
     )
 }
 
-/// Re-checks every row's bracket ([`recheck_bracket`]) at `tighter`, the rows at once, each
+/// Re-checks every row ([`recheck_bracket`]) at `tighter`, the rows at once, each
 /// on `base` with the row's friction coefficient, and records each in its row
 /// ([`Recheck::apply_to`]: an onset that does not hold there leaves the row not converged).
 /// With `cancel`, a drop not yet started when it is raised is skipped (its outcome
-/// "cancelled"; the caller discards the rows) and every drop run is counted on it. Every drop run ticks `ticker`, which expects the
-/// brackets' two drops each, and a window search's as it plans them.
+/// "cancelled"; the caller discards the rows) and every drop run is counted on it. Every drop
+/// run ticks `ticker`, which expects each row's deciding cells, and a window search's drops
+/// as it plans them.
 pub fn recheck_rows(
     base: &Scene,
     rows: &mut [CriticalRow],
@@ -53,7 +59,11 @@ pub fn recheck_rows(
     ticker: Option<&Ticker>,
 ) {
     if let Some(t) = ticker {
-        t.expect_more(2 * rows.iter().filter(|r| r.bracket_rpm.is_some()).count());
+        t.expect_more(
+            rows.iter()
+                .map(|r| deciding_cells(r).map_or(0, cells_len))
+                .sum(),
+        );
     }
     let run = |s: &Scene, speed: f64| {
         let outcome = match cancel {
@@ -88,20 +98,29 @@ fn recheck_with(
     run: &(dyn Fn(&Scene, f64) -> Outcome + Sync),
     ticker: Option<&Ticker>,
 ) -> Option<Recheck> {
-    let [lo, hi] = row.bracket_rpm?;
+    let (lo, hi) = deciding_cells(row)?;
     let s = tighter.applied(scene);
-    let (out_lo, out_hi) = rayon::join(|| run(&s, lo), || run(&s, hi));
+    let (out_lo, out_hi) = rayon::join(
+        || lo.map(|v| (v, run(&s, v))),
+        || hi.map(|v| (v, run(&s, v))),
+    );
     // A settled class below: an unresolved drop is no confirmation (below an onset it
     // leaves a search undecided).
-    let settled_below =
-        matches!(&out_lo, Outcome::Class(c) if !c.is_whirl() && *c != OrbitClass::Unresolved);
-    let confirmed = settled_below && out_hi.whirl() == Some(true);
-    let relocated =
-        (!confirmed).then(|| relocate(&s, row, [(lo, &out_lo), (hi, &out_hi)], run, ticker));
+    let settled_below = out_lo.as_ref().is_none_or(
+        |(_, o)| matches!(o, Outcome::Class(c) if !c.is_whirl() && *c != OrbitClass::Unresolved),
+    );
+    let whirl_above = out_hi.as_ref().is_none_or(|(_, o)| o.whirl() == Some(true));
+    let confirmed = settled_below && whirl_above;
+    let relocated = (!confirmed).then(|| {
+        let known: Vec<(f64, &Outcome)> =
+            out_lo.iter().chain(&out_hi).map(|(v, o)| (*v, o)).collect();
+        let ends = [lo, hi].map(|v| v.or(lo).or(hi).expect("a row has a deciding cell"));
+        relocate(&s, row, ends, &known, run, ticker)
+    });
     let mut rc = Recheck {
         fidelity: tighter,
-        lo: (lo, out_lo),
-        hi: (hi, out_hi),
+        lo: out_lo,
+        hi: out_hi,
         confirmed,
         within_tol: false,
         relocated,
@@ -111,6 +130,28 @@ fn recheck_with(
     Some(rc)
 }
 
+/// The speeds that decide `row`'s answer, below and above the onset: its bracket's two;
+/// without a bracket, the end of its range that decides it: the highest speed scanned with a
+/// class when it found no whirl (below), the lowest when whirl starts there (above, the row's
+/// onset). `None` when nothing was decided (every scan drop failed).
+pub fn deciding_cells(row: &CriticalRow) -> Option<(Option<f64>, Option<f64>)> {
+    if let Some([lo, hi]) = row.bracket_rpm {
+        return Some((Some(lo), Some(hi)));
+    }
+    match row.onset_rpm {
+        Some(onset) => Some((None, Some(onset))),
+        None if row.whirl_intervals_rpm.is_empty() => (row.scan.iter().rev())
+            .find(|p| p.class.is_some())
+            .map(|p| (Some(p.speed_rpm), None)),
+        None => None,
+    }
+}
+
+/// How many cells [`deciding_cells`] names.
+fn cells_len((lo, hi): (Option<f64>, Option<f64>)) -> usize {
+    usize::from(lo.is_some()) + usize::from(hi.is_some())
+}
+
 /// Lattice steps either side of the bracket that [`relocate`] searches first: the convergence
 /// study's tolerance on an onset (docs/accuracy.md).
 const WINDOW_STEPS: f64 = 2.0;
@@ -118,25 +159,26 @@ const WINDOW_STEPS: f64 = 2.0;
 /// Lattice steps either side of the bracket that [`relocate`] widens its window to, at most.
 const MAX_WINDOW_STEPS: f64 = 16.0;
 
-/// Searches `row`'s bracket again on `tighter_scene` (the tighter preset's, with the row's
-/// friction coefficient) on its lattice and tolerance, over a window from [`WINDOW_STEPS`]
-/// lattice steps below the lattice point under the bracket to as many above the one over it,
-/// within the range the row searched. When the tighter preset whirls at the window's lowest
+/// Searches `row`'s deciding cells `[lo, hi]` (its bracket, or twice the end of the range
+/// that decides it) again on `tighter_scene` (the tighter preset's, with the row's friction
+/// coefficient) on its lattice and tolerance, over a window from [`WINDOW_STEPS`] lattice
+/// steps below the lattice point under `lo` to as many above the one over `hi`, within the
+/// range the row searched. When the tighter preset whirls at the window's lowest
 /// speed (or does not at its highest), that side is widened, doubling its steps up to
 /// [`MAX_WINDOW_STEPS`], and searched again. Its ends are lattice points or the range's, so its
 /// scan drops are the ones a search of the whole range drops there, and it finds the onset
 /// that search would, when that onset is in the window above its lower end. No drop runs
-/// twice: the bracket's two at the tighter preset (`known`) and every drop of a narrower
+/// twice: the cells already run at the tighter preset (`known`) and every drop of a narrower
 /// window are answered from memory. `ticker` expects each window's scan and bisections as
 /// they are planned, less those answered from memory.
 fn relocate(
     tighter_scene: &Scene,
     row: &CriticalRow,
-    known: [(f64, &Outcome); 2],
+    [lo, hi]: [f64; 2],
+    known: &[(f64, &Outcome)],
     run: &(dyn Fn(&Scene, f64) -> Outcome + Sync),
     ticker: Option<&Ticker>,
 ) -> Relocated {
-    let [(lo, _), (hi, _)] = known;
     let res = row.resolution_rpm;
     // Every outcome so far by the speed's bits, and the drops run (a cancelled one counts
     // too; a cancelled run's rows are discarded).
@@ -211,6 +253,13 @@ fn relocate(
                 "its onset there undecided in {}-{} r/min by failed or unsettled drops",
                 fmt_rpm(from),
                 fmt_rpm(to)
+            ),
+        ),
+        (false, Some(onset), Some(_)) if row.onset_rpm.is_none() => (
+            Some(onset),
+            format!(
+                "its onset there {} r/min, where the search found no whirl",
+                fmt_rpm(onset)
             ),
         ),
         (false, Some(onset), Some(_)) => {
@@ -301,14 +350,14 @@ mod tests {
 
     /// The re-check of the row searched with whirl from `search_at`, at a "tighter preset"
     /// with whirl from `tighter_at` (`fails` lists speeds whose drop fails there), and the
-    /// speeds it ran. Its progress ticker, expecting the bracket's two drops as
+    /// speeds it ran. Its progress ticker, expecting the row's deciding cells as
     /// [`recheck_rows`] does, expects every drop before it runs, and ends with every drop it
     /// expected run (a failed one may add bisection drops, so not with `fails`).
     fn recheck(search_at: f64, tighter_at: f64, fails: &[f64]) -> (Recheck, Vec<f64>) {
         let ran = Mutex::new(Vec::new());
         let unexpected = Mutex::new(Vec::<f64>::new());
         let ticker = Ticker::off();
-        ticker.expect_more(2);
+        ticker.expect_more(deciding_cells(&row(search_at)).map_or(0, cells_len));
         let run = |_: &Scene, speed: f64| {
             ran.lock().unwrap().push(speed);
             if ticker.expected() <= ticker.done() {
@@ -328,7 +377,7 @@ mod tests {
             &run,
             Some(&ticker),
         )
-        .expect("a bracket");
+        .expect("a deciding cell");
         let ran = ran.into_inner().unwrap();
         assert_eq!(ticker.done(), ran.len());
         if fails.is_empty() {
@@ -340,6 +389,59 @@ mod tests {
             assert_eq!(ticker.expected(), ran.len(), "the progress total");
         }
         (rc, ran)
+    }
+
+    /// A row without a bracket is re-checked at the end of the range that decides it, one
+    /// drop: the top when it found no whirl, the bottom when whirl starts there. Not
+    /// confirmed, the tighter preset's onset is searched for below the top (above the
+    /// bottom) and found where a search of the whole range with it puts it.
+    #[test]
+    fn a_row_without_a_bracket_is_re_checked_at_its_deciding_end() {
+        // No whirl up to 9000 at the search's preset.
+        let (rc, ran) = recheck(9500.0, 9500.0, &[]);
+        assert_eq!(ran, [9000.0]);
+        assert!(rc.confirmed && rc.hi.is_none());
+        assert_eq!(rc.lo, Some((9000.0, Outcome::Class(Pendulum))));
+        let (rc, _) = recheck(9500.0, 8621.0, &[]);
+        let w = rc.relocated.as_ref().expect("searched again");
+        assert!(!rc.confirmed && !rc.within_tol);
+        assert_eq!(w.window_rpm, [8500.0, 9000.0], "two steps below the top");
+        assert_eq!(w.onset_rpm, row(8621.0).onset_rpm);
+        assert!(
+            w.note.ends_with("where the search found no whirl"),
+            "{}",
+            w.note
+        );
+        // Whirl from 1000 (the range bottom) at the search's preset.
+        let (rc, ran) = recheck(500.0, 500.0, &[]);
+        assert_eq!(ran, [1000.0]);
+        assert!(rc.confirmed && rc.lo.is_none());
+        let (rc, _) = recheck(500.0, 1321.0, &[]);
+        let w = rc.relocated.as_ref().expect("searched again");
+        assert!(!rc.confirmed);
+        assert_eq!(w.window_rpm, [1000.0, 1500.0], "two steps above the bottom");
+        assert_eq!(w.onset_rpm, row(1321.0).onset_rpm);
+        // Beyond the first window: widened above until the onset lies in it.
+        let (rc, _) = recheck(500.0, 2600.0, &[]);
+        let w = rc.relocated.as_ref().expect("searched again");
+        assert_eq!(w.onset_rpm, row(2600.0).onset_rpm);
+        // An unresolved drop at the top is no confirmation of "no whirl".
+        let mut r = row(9500.0);
+        let rc = recheck_with(
+            &Scene::paper(),
+            &r,
+            Fidelity::Standard,
+            &|_, _| Outcome::Class(Unresolved),
+            None,
+        )
+        .unwrap();
+        assert!(!rc.confirmed);
+        // A row every scan drop of which failed decides nothing and is not re-checked.
+        r.scan.iter_mut().for_each(|p| {
+            p.class = None;
+            p.error = Some("x".into());
+        });
+        assert_eq!(deciding_cells(&r), None);
     }
 
     #[test]

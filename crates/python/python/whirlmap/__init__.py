@@ -260,7 +260,9 @@ def critical(
     For each friction coefficient: a scan over every multiple of ``resolution_rpm`` in
     ``[from_rpm, to_rpm]`` (and both ends), then a bisection of every class transition down
     to ``tol_rpm`` (docs/critical-speed.md). With a ``fidelity`` preset, the onset bracket is
-    re-checked at the next tighter preset (the row's ``recheck``).
+    re-checked at the next tighter preset (the row's ``recheck``); a row without one at the
+    end of the range that decides it (the top for no whirl, the bottom for whirl from the
+    start).
 
     Args:
         mu: One friction coefficient or several, each in [0, 2].
@@ -292,12 +294,15 @@ def critical(
             names the friction coefficients and their failed or unsettled drops. Every row
             is returned.
             Also when, with a ``fidelity`` preset, the re-check at the next tighter preset
-            does not confirm some row's onset bracket and does not find that preset's onset
-            within ``tol_rpm`` of it (``within_tol``; the command line exits 1 then too);
+            does not confirm some row's onset bracket (or, for a row without one, the end of
+            the range that decides it: its highest speed when it found no whirl, its lowest
+            when whirl starts there) and does not find that preset's onset within
+            ``tol_rpm`` of it (``within_tol``; the command line exits 1 then too);
             that row's ``converged`` is then false and its ``note`` says ``NOT CONFIRMED by
             the re-check`` (at its head, or at the end of an undecided row's note, which
             starts with ``UNDECIDED``). The search then runs again at the tighter preset
-            over at least two lattice steps either side of the bracket (within the range), and
+            over at least two lattice steps either side of the cells re-run (within the
+            range), and
             ``recheck["relocated"]`` says where that preset puts the onset (``onset_rpm``,
             null when not in that window, and a ``note`` that the row's note repeats).
 
@@ -364,7 +369,7 @@ def critical(
         warnings.warn(
             "the re-check at the next tighter preset does not confirm the onset at "
             + ", ".join(unconfirmed)
-            + "; the onset at this preset is not to be trusted there (each row's"
+            + "; the answer at this preset is not to be trusted there (each row's"
             + " recheck says where the tighter preset puts it)",
             RuntimeWarning,
             stacklevel=2,
