@@ -52,6 +52,7 @@ pub fn run(a: &MergeArgs) -> CmdResult {
                 o.ok,
                 o.failed
             );
+            crate::sweep_cmd::report_failed(&out, o.failed);
             for (class, n) in &o.classes {
                 outln!("  {class:<16} {n}");
             }

@@ -44,6 +44,7 @@ pub fn run(a: &SweepArgs, spec: &SweepSpec, index: usize, count: usize) -> CmdRe
         shard.label(),
         counts(&outcome)
     );
+    crate::sweep_cmd::report_failed(&opts.out_dir, outcome.failed);
     let undecided = match critical {
         Some(p) => critical_line(&opts.out_dir, &p),
         None => false,

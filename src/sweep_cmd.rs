@@ -117,6 +117,29 @@ pub(crate) fn critical_line(dir: &Path, path: &Path) -> bool {
     undecided || unconfirmed
 }
 
+/// Says on standard error, when some of the points in `out_dir` failed, how many by error
+/// kind and the first one's inputs and message (each point's is in `points.jsonl` and
+/// `summary.csv`). The shard and merge commands say it the same way.
+pub(crate) fn report_failed(out_dir: &Path, failed: usize) {
+    if failed == 0 {
+        return;
+    }
+    let path = out_dir.join(whirlmap_sweep::results::files::POINTS_FILE);
+    match std::fs::read_to_string(&path) {
+        Ok(text) => {
+            if let Some(s) = whirlmap_sweep::results::summary::failure_summary(&text) {
+                errln!(
+                    "error: {s} (every failed point's error is in points.jsonl and summary.csv)"
+                );
+            }
+        }
+        Err(e) => errln!(
+            "error: {failed} points failed; cannot read {}: {e}",
+            path.display()
+        ),
+    }
+}
+
 /// Runs the subcommand: `Flagged` (exit 1) when some points failed, failed drops left a
 /// critical speed undecided or an onset does not hold at the re-check.
 pub fn run(a: &SweepArgs) -> CmdResult {
@@ -141,6 +164,7 @@ pub fn run(a: &SweepArgs) -> CmdResult {
     };
     let on_grid = |outcome: &SweepOutcome| {
         outln!("sweep {}: {}", spec.name, counts(outcome));
+        report_failed(&outcome.out_dir, outcome.failed);
         for (class, n) in &outcome.classes {
             outln!("  {class:<16} {n}");
         }

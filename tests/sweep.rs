@@ -313,6 +313,15 @@ fn a_failed_point_is_recorded_and_the_sweep_goes_on() {
     let o = whirlmap(&["sweep", s(&spec), "--out", s(&out), "--no-progress"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("2 failed"));
+    // Standard error says why, by kind, with the first failed point.
+    assert!(
+        stderr(&o).contains(
+            "error: 2 of 4 points failed (step_budget 2); the first, index 0 \
+             (solver.max_step_attempts 10, mu 0.1): step budget"
+        ),
+        "{}",
+        stderr(&o)
+    );
     let recs = lines(&out.join("points.jsonl"));
     assert_eq!(recs.len(), 4);
     for r in &recs[..2] {

@@ -200,3 +200,116 @@ pub fn csv_field(s: &str) -> String {
         s.to_string()
     }
 }
+
+/// The failed points of a sweep's `points.jsonl` text, in words: how many failed of how
+/// many, by error kind (most first), and the first failed point's index, inputs and message:
+/// `3 of 4 points failed (event_budget 2, step_budget 1); the first, index 0 (speed_rpm
+/// 6000, mu 0.2): event budget of 20 mode switches exhausted at t = 0.0188 s`. `None` when
+/// no line is a failed point. Lines that are not records are skipped.
+pub fn failure_summary(points_jsonl: &str) -> Option<String> {
+    let mut kinds: std::collections::BTreeMap<String, usize> = Default::default();
+    let (mut total, mut failed) = (0usize, 0usize);
+    let mut first: Option<String> = None;
+    for line in points_jsonl.lines() {
+        let Ok(v) = serde_json::from_str::<serde_json::Value>(line) else {
+            continue;
+        };
+        total += 1;
+        if v["status"] != "failed" {
+            continue;
+        }
+        failed += 1;
+        let error = &v["error"];
+        let kind = error["kind"].as_str().unwrap_or("unknown");
+        *kinds.entry(kind.to_string()).or_insert(0) += 1;
+        if first.is_none() {
+            let inputs = inputs_in_order(line)
+                .iter()
+                .map(|(k, x)| match x.as_f64() {
+                    Some(x) => format!("{k} {}", whirlmap_core::scene::num(x)),
+                    None => format!("{k} {x}"),
+                })
+                .collect::<Vec<_>>()
+                .join(", ");
+            let message = error["message"].as_str().unwrap_or(kind);
+            first = Some(format!(
+                "the first, index {} ({inputs}): {message}",
+                v["index"]
+            ));
+        }
+    }
+    let first = first?;
+    let mut by_kind: Vec<(String, usize)> = kinds.into_iter().collect();
+    by_kind.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+    let by_kind = by_kind
+        .iter()
+        .map(|(k, n)| format!("{k} {n}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Some(format!(
+        "{failed} of {total} points failed ({by_kind}); {first}"
+    ))
+}
+
+/// A record line's `inputs` in the order written (the sweep's axes), which a
+/// `serde_json::Map` would sort by name.
+fn inputs_in_order(line: &str) -> Vec<(String, serde_json::Value)> {
+    /// The pairs of a JSON object, in order.
+    struct Pairs(Vec<(String, serde_json::Value)>);
+    impl<'de> Deserialize<'de> for Pairs {
+        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            struct V;
+            impl<'de> serde::de::Visitor<'de> for V {
+                type Value = Pairs;
+                fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                    f.write_str("an object")
+                }
+                fn visit_map<A: serde::de::MapAccess<'de>>(
+                    self,
+                    mut m: A,
+                ) -> Result<Pairs, A::Error> {
+                    let mut v = Vec::new();
+                    while let Some(pair) = m.next_entry()? {
+                        v.push(pair);
+                    }
+                    Ok(Pairs(v))
+                }
+            }
+            d.deserialize_map(V)
+        }
+    }
+    #[derive(Deserialize)]
+    struct Line {
+        inputs: Option<Pairs>,
+    }
+    serde_json::from_str::<Line>(line)
+        .ok()
+        .and_then(|l| l.inputs)
+        .map_or_else(Vec::new, |p| p.0)
+}
+
+#[cfg(test)]
+mod failure_tests {
+    use super::failure_summary;
+
+    #[test]
+    fn failed_points_are_counted_by_kind_with_the_first_one_named() {
+        let text = [
+            r#"{"index":0,"inputs":{"speed_rpm":6000.0,"mu":0.2},"status":"failed","error":{"kind":"event_budget","message":"event budget of 20 mode switches exhausted"}}"#,
+            r#"{"index":1,"inputs":{"speed_rpm":6000.0,"mu":0.4},"status":"ok","record":{}}"#,
+            "torn line",
+            r#"{"index":2,"inputs":{"speed_rpm":8000.0,"mu":0.2},"status":"failed","error":{"kind":"step_budget","message":"x"}}"#,
+            r#"{"index":3,"inputs":{"speed_rpm":8000.0,"mu":0.4},"status":"failed","error":{"kind":"step_budget","message":"y"}}"#,
+        ]
+        .join("\n");
+        assert_eq!(
+            failure_summary(&text).as_deref(),
+            Some(
+                "3 of 4 points failed (step_budget 2, event_budget 1); the first, index 0 \
+                 (speed_rpm 6000, mu 0.2): event budget of 20 mode switches exhausted"
+            )
+        );
+        assert_eq!(failure_summary(r#"{"index":0,"status":"ok"}"#), None);
+        assert_eq!(failure_summary(""), None);
+    }
+}
