@@ -22,7 +22,7 @@ pub enum FrictionLaw {
     /// `F_t = mu_d F_n tanh(v_rel / v_eps_m_s)`: a cheaper approximation with no stick mode.
     /// Its error against `switched` is measured, not assumed (docs/accuracy.md).
     Regularised {
-        /// Slip velocity scale of the tanh (m/s), > 0.
+        /// Slip velocity scale of the tanh (m/s), in (0, 10].
         v_eps_m_s: f64,
     },
 }
@@ -541,7 +541,10 @@ impl Scene {
                 "mu_static",
                 ms,
                 ms >= self.mu_dynamic && ms <= 2.0,
-                "[mu_dynamic, 2] (or null for mu_dynamic)",
+                &format!(
+                    "[mu_dynamic, 2] with mu_dynamic = {} here (or null for mu_dynamic)",
+                    num(self.mu_dynamic)
+                ),
             )?;
         }
         if let FrictionLaw::Regularised { v_eps_m_s } = self.friction_law {

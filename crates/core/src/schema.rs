@@ -53,6 +53,11 @@ pub const FIELD_RANGES: &[FieldRange] = &[
     r("race_mass_kg", Some(In(1e-5)), Some(In(1e6))),
     r("race_polar_moi_kg_m2", Some(Ex(0.0)), None),
     r("clearance_m", Some(Ex(0.0)), Some(In(0.1))),
+    r(
+        "friction_law.regularised.v_eps_m_s",
+        Some(Ex(0.0)),
+        Some(In(10.0)),
+    ),
     r("contact_stiffness_n_per_m_e", Some(Ex(0.0)), None),
     r("contact_exponent", Some(In(1.0)), Some(In(2.0))),
     r("contact_damping_n_s_per_m", Some(In(0.0)), Some(In(1e8))),
@@ -339,6 +344,15 @@ pub fn scene_schema() -> serde_json::Value {
     if let Some(Value::Object(props)) = root.get_mut("properties") {
         annotate(props, "");
     }
+    // The regularised friction law's field, inside its variant of the enum.
+    if let Some(Value::Array(variants)) = root.pointer_mut("/$defs/FrictionLaw/oneOf") {
+        for v in variants {
+            if let Some(Value::Object(props)) = v.pointer_mut("/properties/regularised/properties")
+            {
+                annotate(props, "friction_law.regularised");
+            }
+        }
+    }
     for (field, def) in nested {
         if let Some(Value::Object(props)) = root
             .get_mut("$defs")
@@ -369,7 +383,18 @@ mod tests {
         let mut node = &mut root;
         let parts: Vec<&str> = key.split('.').collect();
         for p in &parts[..parts.len() - 1] {
-            node = node.get_mut(*p).unwrap();
+            // A variant with fields (the regularised friction law) replaces a unit one.
+            if !node.is_object() {
+                *node = Value::Object(Default::default());
+            }
+            node = node
+                .as_object_mut()
+                .unwrap()
+                .entry(p.to_string())
+                .or_insert_with(|| Value::Object(Default::default()));
+        }
+        if !node.is_object() {
+            *node = Value::Object(Default::default());
         }
         let integer = ["ball_count", "balls_per_row", "bearing.rows"];
         let value = if integer.iter().any(|i| key.ends_with(i)) || key.starts_with("solver.max_") {
@@ -529,6 +554,11 @@ mod tests {
             );
         }
         assert_eq!(bearing["balls_per_row"]["minimum"], 3.0);
+        let v_eps = &schema["$defs"]["FrictionLaw"]["oneOf"][1]["properties"]["regularised"]
+            ["properties"]["v_eps_m_s"];
+        assert_eq!(v_eps["exclusiveMinimum"], 0.0, "{v_eps}");
+        assert_eq!(v_eps["maximum"], 10.0, "{v_eps}");
+        assert_eq!(v_eps["x-unit"], "m/s", "{v_eps}");
         assert_eq!(bearing["balls_per_row"]["maximum"], 1000.0);
         assert_eq!(bearing["rows"]["minimum"], 1.0);
         assert_eq!(bearing["young_modulus_pa"]["x-unit"], "Pa");
