@@ -74,9 +74,21 @@ pub fn with_suggestion(message: &str) -> String {
         return message;
     };
     let known: Vec<&str> = tail.split('`').skip(1).step_by(2).collect();
-    match did_you_mean(given, known) {
-        Some(best) => format!("{message} (did you mean `{best}`?)"),
-        None => message,
+    let Some(best) = did_you_mean(given, known) else {
+        return message;
+    };
+    // The suggestion first, beside the misspelt key, and the position before the long list
+    // of known keys: `unknown field `clearence_m` (did you mean `clearance_m`?) at line 1
+    // column 14; expected one of ...`.
+    let head = &message[..message.len() - rest.len()];
+    let list = tail.trim_start_matches(", ");
+    match list.rfind(" at line ") {
+        Some(at) => format!(
+            "{head}{given}` (did you mean `{best}`?){}; {}",
+            &list[at..],
+            &list[..at]
+        ),
+        None => format!("{head}{given}` (did you mean `{best}`?); {list}"),
     }
 }
 
@@ -507,10 +519,15 @@ mod tests {
         // serde's message for a scene or sweep file
         let text = r#"{"clearence_m": 1e-4}"#;
         let err = whirlmap_core::json::from_str::<Scene>(text).unwrap_err();
+        let m = with_suggestion(&err.to_string());
         assert!(
-            with_suggestion(&err.to_string()).ends_with("(did you mean `clearance_m`?)"),
-            "{err}"
+            m.starts_with(
+                "unknown field `clearence_m` (did you mean `clearance_m`?) at line 1 column \
+                 14; expected one of `speed_rpm`, "
+            ),
+            "{m}"
         );
+        assert!(m.ends_with("`bearing`"), "{m}");
         assert_eq!(with_suggestion("expected value"), "expected value");
         // A value of the wrong type in a file: the field's path, the value, and the type in
         // words.
