@@ -17,7 +17,7 @@
 #![warn(missing_docs)]
 
 use numpy::IntoPyArray;
-use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
@@ -41,6 +41,20 @@ pyo3::create_exception!(
     "A drop could not be integrated to its end: a typed solver error (its kind and the \
      simulated time of the failure are in the message)."
 );
+
+/// A spec file that cannot be read: an `OSError` with the errno, the message and the path,
+/// which Python turns into its subclass (`FileNotFoundError` for a missing file,
+/// `PermissionError`, ...); any other spec error: a `ValueError`.
+fn spec_error(e: spec::SpecError) -> PyErr {
+    match &e {
+        spec::SpecError::Read { path, source } => PyOSError::new_err((
+            source.raw_os_error().unwrap_or(0),
+            e.to_string(),
+            path.display().to_string(),
+        )),
+        _ => value_error(e),
+    }
+}
 
 /// A `ValueError` with `e`'s message.
 fn value_error(e: impl std::fmt::Display) -> PyErr {
@@ -309,7 +323,7 @@ fn sweep(
             s.validate().map_err(value_error)?;
             s
         }
-        (None, Some(p)) => spec::read(&p).map_err(value_error)?,
+        (None, Some(p)) => spec::read(&p).map_err(spec_error)?,
         (None, None) => return Err(value_error("a sweep spec (text or path) is required")),
     };
     spec.check_points().map_err(value_error)?;

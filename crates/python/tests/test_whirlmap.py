@@ -287,8 +287,9 @@ def test_a_bad_sweep_spec_raises() -> None:
         whirlmap.sweep({**SPEC, "axes": {"mu": [3.0]}})
     with pytest.raises(ValueError, match="clearence_m"):
         whirlmap.sweep({**SPEC, "axes": {"clearence_m": [1e-4]}})
-    with pytest.raises(ValueError, match="cannot read"):
+    with pytest.raises(FileNotFoundError, match="cannot read") as e:
         whirlmap.sweep("/nonexistent/spec.json")
+    assert e.value.filename == "/nonexistent/spec.json"
 
 
 def test_threads_run_drops_concurrently() -> None:

@@ -416,8 +416,10 @@ def sweep(
         reads them.
 
     Raises:
-        ValueError: The spec is unreadable or invalid (the message names the field, the
-            value and the allowed range); nothing has run.
+        ValueError: The spec is invalid (the message names the field, the value and the
+            allowed range); nothing has run.
+        OSError: The spec file cannot be read (``FileNotFoundError`` when it does not
+            exist, with its ``filename``); nothing has run.
         KeyboardInterrupt: Ctrl-C (or a notebook's "interrupt kernel") while the grid runs,
             when called from Python's main thread: the points not yet started are skipped,
             the running ones finish (at most a drop's time), and no record is returned; the
