@@ -182,6 +182,16 @@ pub fn running_writer(dir: &Path) -> Option<String> {
 /// The error for an output folder that cannot be created or written: bad input (exit 2) for
 /// a bad path, an I/O error (exit 4) when the storage failed.
 pub fn output_error(dir: &Path, source: std::io::Error) -> SweepError {
+    // A file where the folder should be: said in words, not as "File exists (os error 17)".
+    let in_the_way = source.kind() == std::io::ErrorKind::AlreadyExists;
+    let source = if in_the_way && dir.exists() && !dir.is_dir() {
+        std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            "it is a file, not a folder (give --out a folder)",
+        )
+    } else {
+        source
+    };
     if is_storage_error(&source) {
         SweepError::Io {
             path: dir.to_path_buf(),

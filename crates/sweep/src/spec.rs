@@ -1369,6 +1369,10 @@ mod tests {
             "{e}"
         );
         assert_eq!(e.exit_code(), 2);
+        // The file itself as the folder: said in words, exit 2.
+        let e = check_output_dir(&file).unwrap_err();
+        assert!(e.to_string().contains("is a file, not a folder"), "{e}");
+        assert_eq!(e.exit_code(), 2);
         check_output_dir(&dir.join("out")).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }
