@@ -16,7 +16,8 @@ use whirlmap_sweep::accuracy::{run, to_csv, to_markdown, AccuracySpec, AccuracyS
 /// Arguments of `whirlmap accuracy`.
 #[derive(clap::Args)]
 pub struct AccuracyArgs {
-    /// Case file (JSON): cases, tolerance ladder, settings.
+    /// Case file (JSON): cases, tolerance ladder, settings. The default is relative to the
+    /// repository's top; run elsewhere, give the file's path.
     #[arg(long, default_value = "sweeps/accuracy-cases.json")]
     cases: PathBuf,
     /// Output folder. A folder that already holds results (the committed `results/accuracy`

@@ -32,7 +32,7 @@ pub struct CompareArgs {
     )]
     power_rel: f64,
     /// The Markdown report; the class map goes beside it as `<stem>-classes.png`. Default
-    /// NEW/compare.md.
+    /// NEW/compare.md. Its folder is created if missing (a nightly job's dated folder).
     #[arg(long)]
     out: Option<PathBuf>,
 }

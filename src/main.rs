@@ -465,7 +465,15 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
         orbit_points: a.orbit.as_ref().map(|_| 20_000),
         ..Default::default()
     };
-    opts.validate().map_err(|e| Failure::Input(e.into()))?;
+    opts.validate().map_err(|e| {
+        // The duration is the flag's: named by it, as `critical` names its own.
+        Failure::Input(match e.field.as_str() {
+            "duration_s" => {
+                anyhow::anyhow!("invalid --duration-s = {}: allowed {}", e.value, e.allowed)
+            }
+            _ => e.into(),
+        })
+    })?;
     let start = Instant::now();
     let report = simulate(&scene, &opts)
         .map_err(|e| Failure::Solve(anyhow::anyhow!("simulation failed ({}): {e}", e.kind())))?;

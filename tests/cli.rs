@@ -121,8 +121,8 @@ fn bad_input_exits_2_naming_field_value_and_range() {
         (&["--mu", "2.5"], &["--mu = 2.5", "mu_dynamic", "[0, 2]"]),
         (&["--mu", "-0.1"], &["mu_dynamic", "-0.1"]),
         (&["--mu", "NaN"], &["mu_dynamic", "NaN"]),
-        (&["--duration-s", "0"], &["duration_s", "0", "(0, 3600]"]),
-        (&["--duration-s", "-1"], &["duration_s", "-1"]),
+        (&["--duration-s", "0"], &["--duration-s = 0", "(0, 3600]"]),
+        (&["--duration-s", "-1"], &["--duration-s = -1"]),
         (&["--mu", "abc"], &["--mu", "abc", "not a number", "[0, 2]"]),
         (
             &["--speed-rpm", "fast"],
