@@ -549,8 +549,10 @@ impl Figure for GridFigure<'_> {
                             "forward whirl (hatched the other way)".to_string(),
                         ));
                     }
-                } else {
-                    // The backward-whirl entry is always shown: it is where the scale stops.
+                }
+                // Named only when drawn: an entry for cells the map does not have would read
+                // as if some drops had whirled.
+                if whirl_seen[0] {
                     entries.push((
                         Mark::Hatch(false),
                         "backward whirl (not in colour scale)".to_string(),

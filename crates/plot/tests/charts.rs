@@ -478,3 +478,43 @@ fn near_equal_cells_are_drawn_alike() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A map without backward-whirl cells does not name them in its legend (it did always, so a
+/// sweep whose every drop failed, or whose drops all settled into pendulum vibration, read as
+/// if some had whirled); one with them still does.
+#[test]
+fn the_whirl_legend_entry_names_only_cells_drawn() {
+    let entry = "backward whirl (not in colour scale)";
+    let grid = |class: [&'static str; 4]| -> Vec<(f64, f64, &'static str, f64, f64)> {
+        vec![
+            (4000.0, 0.3, class[0], 900.0, 500.0),
+            (8000.0, 0.3, class[1], 950.0, 600.0),
+            (4000.0, 0.4, class[2], 1000.0, 700.0),
+            (8000.0, 0.4, class[3], 1100.0, 800.0),
+        ]
+    };
+    let cases = [
+        ("all-failed", grid(["failed"; 4]), false),
+        ("all-pendulum", grid(["pendulum"; 4]), false),
+        (
+            "forward-only",
+            grid(["pendulum", "pendulum", "pendulum", "forward_whirl"]),
+            false,
+        ),
+        (
+            "one-whirl",
+            grid(["pendulum", "pendulum", "pendulum", "backward_whirl"]),
+            true,
+        ),
+    ];
+    for (name, points, named) in cases {
+        let dir = temp_dir(&format!("whirl-legend-{name}"));
+        write_points(&dir, &points);
+        render_all(&dir).unwrap();
+        for stem in ["fig5_max_force", "fig6_peak_power"] {
+            let svg = std::fs::read_to_string(dir.join(format!("charts/{stem}.svg"))).unwrap();
+            assert_eq!(svg.contains(entry), named, "{name}: {stem}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
