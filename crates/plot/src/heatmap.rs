@@ -373,7 +373,9 @@ impl Figure for GridFigure<'_> {
         let mut limit_entry = None;
         if let (GridMode::Metric(_), Some((lo, hi))) = (self.mode, scale) {
             let m = metric.expect("a metric mode");
-            if values.len() >= 2 {
+            // No contour levels on a scale widened to its floor: a line between cells that
+            // close would part what the colours show as alike.
+            if values.len() >= 2 && scale == data_range {
                 levels = match m.log {
                     // Whole decades, when the scale spans two or more.
                     true if hi.floor() - lo.ceil() >= 1.0 => (lo.ceil() as i64..=hi.floor() as i64)

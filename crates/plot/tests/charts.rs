@@ -447,7 +447,8 @@ fn cell_fills(svg: &str) -> Vec<[u8; 3]> {
 /// Two pendulum cells 0.00002 % apart (solver noise, far below the 0.1 % accuracy budget)
 /// take alike colours from the middle of the scale: they were drawn one at each end of it, as
 /// if they were the map's lowest and highest results, with a colour bar from 880.1318 to
-/// 880.1319 N. The whirl cells are outside the scale either way.
+/// 880.1319 N. The whirl cells are outside the scale either way. Nor does a contour line
+/// part such cells.
 #[test]
 fn near_equal_cells_are_drawn_alike() {
     let dir = temp_dir("near-equal");
@@ -475,6 +476,33 @@ fn near_equal_cells_are_drawn_alike() {
             "{stem}: {a:?} is not the middle"
         );
         assert!(!svg.contains("880.1318"), "{stem}: a bar over the noise");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+
+    // Four such cells either side of a round value: no contour line parts them.
+    let dir = temp_dir("near-equal-contour");
+    let (a, b) = (499.9999, 500.0001);
+    write_points(
+        &dir,
+        &[
+            (4000.0, 0.3, "pendulum", 880.0 - 1e-4, a),
+            (8000.0, 0.3, "pendulum", 880.0 + 1e-4, b),
+            (4000.0, 0.4, "pendulum", 880.0 - 1e-4, a),
+            (8000.0, 0.4, "pendulum", 880.0 + 1e-4, b),
+        ],
+    );
+    render_all(&dir).unwrap();
+    for stem in ["fig5_max_force", "fig6_peak_power"] {
+        let svg = std::fs::read_to_string(dir.join(format!("charts/{stem}.svg"))).unwrap();
+        assert!(
+            !svg.contains("contour lines"),
+            "{stem}: a contour over the noise"
+        );
+        let fills = cell_fills(&svg);
+        assert_eq!(fills.len(), 4, "{stem}: {fills:?}");
+        assert!(fills
+            .iter()
+            .all(|f| f.iter().zip(fills[0]).all(|(x, y)| x.abs_diff(y) <= 2)));
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
