@@ -15,6 +15,9 @@
 //! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
 //!   to the top of the searched range;
 //! - **no whirl in range** as an open triangle at the range top;
+//! - the **searched range**: its top as a dashed line with its value, and its bottom (the
+//!   rows' `from_rpm`) the same way when it is above the axis's 0, the speeds below it shaded
+//!   as not searched, so that they do not read as speeds without whirl;
 //! - the **whirl-probability band** over uncontrolled release conditions: P(whirl) from 10 %
 //!   to 90 % shaded, 50 % dashed. Near the boundary the outcome is a probability; the single
 //!   symmetric drops of the curve are one sample of it.
@@ -125,6 +128,7 @@ impl Figure for Fig4<'_> {
             .fold(0.0_f64, f64::max)
             .max(1.0);
         let y1 = top * 1.12;
+        let bottom = searched_bottom(&rows);
 
         let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (_, bh) = body.dim_in_pixel();
@@ -136,8 +140,17 @@ impl Figure for Fig4<'_> {
             .margin_bottom(4)
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
-            .build_cartesian_2d(x0..x1, 0.0..y1)?;
+            .build_cartesian_2d(x0..x1, AXIS_BOTTOM_RPM..y1)?;
         draw_mesh(&mut chart, MU_DESC, "release speed (r/min)", 10, 8)?;
+
+        // The speeds below the searched range, shaded under everything else: no marker there
+        // means nothing was run, not that the rotor did not whirl.
+        if let Some(b) = bottom {
+            chart.draw_series([Rectangle::new(
+                [(x0, AXIS_BOTTOM_RPM), (x1, b)],
+                UNSEARCHED.filled(),
+            )])?;
+        }
 
         // The probability band first, under everything else.
         if band.len() >= 2 {
@@ -299,47 +312,68 @@ impl Figure for Fig4<'_> {
             any_none = true;
             triangle_up(&canvas, px(r.mu, clamp_value(r.to_rpm)), 8, NONE_MARK)?;
         }
-        // The top of the searched range, as a faint line with its value.
+        // The top of the searched range, as a faint line with its value above it.
         if let Some(t) = rows.iter().map(|r| clamp_value(r.to_rpm)).reduce(f64::max) {
             let (a, b) = (px(x0, t), px(x1, t));
-            canvas.draw(&DashedPathElement::new(
-                vec![a, b],
-                4,
-                4,
-                NONE_MARK.mix(0.6).stroke_width(1),
-            ))?;
+            range_line(&canvas, a, b)?;
             let label = format!("top of the searched range, {} r/min", format_quantity(t));
             let style = text_style(13.0)
                 .color(&NONE_MARK)
                 .pos(Pos::new(HPos::Left, VPos::Bottom));
-            // At the left end of the line, unless a column's arrow (whirl to the range top)
-            // would cross it there; then in the widest gap between arrows if it fits,
-            // else at the right end; at the left end when every place is crossed.
+            // Clear of the columns' arrows (whirl to the range top), which cross the line.
             let width = canvas.estimate_text_size(&label, &style)?.0 as i32;
             let arrows: Vec<i32> = (rows.iter())
                 .filter(|r| r.whirl_at_range_top && !r.whirl_intervals_rpm.is_empty())
                 .map(|r| px(r.mu, t).0)
                 .collect();
-            let clear = |x: i32| arrows.iter().all(|&c| c + 8 < x || c - 8 > x + width);
-            // Gaps between arrows: a triangle (no whirl) sits below the label.
-            let mut edges = arrows.clone();
-            edges.push(b.0);
-            let gap = edges
-                .iter()
-                .scan(a.0, |left, &right| {
-                    let g = (*left, right);
-                    *left = right;
-                    Some(g)
-                })
-                .max_by_key(|(l, r)| r - l)
-                .filter(|(l, r)| r - l >= width + 40)
-                .map(|(l, r)| (l + r - width) / 2);
-            let x = [Some(a.0 + 6), gap, Some(b.0 - 6 - width)]
-                .into_iter()
-                .flatten()
-                .find(|&x| clear(x))
-                .unwrap_or(a.0 + 6);
+            let x = label_x(a.0, b.0, width, &arrows);
             canvas.draw_text(&label, &style, (x, a.1 - 12))?;
+        }
+        // The bottom of the searched range, when the axis starts below it: marked as the top
+        // is, its label in the unsearched band below the line (above it when the band is too
+        // narrow for the text).
+        if let Some(lo) = bottom {
+            let (a, b) = (px(x0, lo), px(x1, lo));
+            range_line(&canvas, a, b)?;
+            let label = format!(
+                "bottom of the searched range, {} r/min",
+                format_quantity(lo)
+            );
+            let below = text_style(13.0)
+                .color(&NONE_MARK)
+                .pos(Pos::new(HPos::Left, VPos::Top));
+            let (width, height) = canvas.estimate_text_size(&label, &below)?;
+            let (width, height) = (width as i32, height as i32);
+            // Below the line: the onset dots on it reach 6 px down, and the arrows of onsets
+            // found at the lowest speed 12 px, beside their dot.
+            let room = px(x0, AXIS_BOTTOM_RPM).1 - a.1;
+            let (style, y, obstacles) = if room >= 8 + height + 2 {
+                let arrows: Vec<i32> = onsets
+                    .iter()
+                    .zip(&rows)
+                    .filter(|(o, r)| o.is_some() && r.bracket_rpm.is_none())
+                    .map(|(_, r)| px(r.mu, lo).0 + 14)
+                    .collect();
+                (below, a.1 + 8, arrows)
+            } else {
+                // Above the line: clear of every column with a mark (an onset, an interval,
+                // an arrow) that reaches down into the label's height.
+                let reach = 12 + height + 22;
+                let columns: Vec<i32> = (rows.iter())
+                    .filter(|r| {
+                        let lowest = (r.whirl_intervals_rpm.iter().map(|w| w[0]))
+                            .chain(r.onset_rpm)
+                            .map(clamp_value)
+                            .reduce(f64::min);
+                        lowest.is_some_and(|s| a.1 - px(r.mu, s).1 <= reach)
+                    })
+                    .flat_map(|r| [px(r.mu, lo).0, px(r.mu, lo).0 + 14])
+                    .collect();
+                let above = below.pos(Pos::new(HPos::Left, VPos::Bottom));
+                (above, a.1 - 12, columns)
+            };
+            let x = label_x(a.0, b.0, width, &obstacles);
+            canvas.draw_text(&label, &style, (x, y))?;
         }
 
         let mut entries = vec![
@@ -388,6 +422,12 @@ impl Figure for Fig4<'_> {
         if any_none {
             entries.push((Mark::TriangleUp(NONE_MARK), "no whirl in range".to_string()));
         }
+        if bottom.is_some() {
+            entries.push((
+                Mark::Swatch(UNSEARCHED.to_rgba().into_rgb()),
+                "not searched".to_string(),
+            ));
+        }
         if let Some((b, label)) = &self.band {
             if b.len() >= 2 {
                 entries.push((Mark::Fill(PROB), format!("P(whirl) 10-90 % {label}")));
@@ -405,6 +445,63 @@ impl Figure for Fig4<'_> {
         }
         legend(&legend_band, &entries)
     }
+}
+
+/// Where the speed axis starts (r/min): at rest, so a chart's speeds read from zero.
+const AXIS_BOTTOM_RPM: f64 = 0.0;
+
+/// The shading of the speeds below the searched range.
+const UNSEARCHED: RGBAColor = RGBAColor(90, 90, 90, 0.14);
+
+/// The bottom of the searched range (r/min), the lowest `from_rpm` of `rows` (below it no
+/// search ran: `critical.json` records each row's range as the sweep's `critical.speed_rpm`
+/// or `whirlmap critical --from` set it), when it is above the speed axis's bottom; `None`
+/// when a search starts at the bottom, or there are no rows.
+fn searched_bottom(rows: &[&CriticalRow]) -> Option<f64> {
+    rows.iter()
+        .map(|r| clamp_value(r.from_rpm))
+        .filter(|f| f.is_finite())
+        .reduce(f64::min)
+        .filter(|&f| f > AXIS_BOTTOM_RPM)
+}
+
+/// Draws an end of the searched range across the chart, from `a` to `b`: a faint dashed line.
+fn range_line<DB: DrawingBackend>(
+    canvas: &DrawingArea<DB, Shift>,
+    a: (i32, i32),
+    b: (i32, i32),
+) -> DrawResult<DB> {
+    canvas.draw(&DashedPathElement::new(
+        vec![a, b],
+        4,
+        4,
+        NONE_MARK.mix(0.6).stroke_width(1),
+    ))
+}
+
+/// Where a label `width` px wide starts on a line from `left` to `right` (pixels) that the
+/// columns centred at `obstacles` cross, 16 px wide each: at the left end if clear, else in
+/// the widest gap between obstacles if it fits with 20 px to spare on each side, else at the
+/// right end; at the left end when every place is crossed.
+fn label_x(left: i32, right: i32, width: i32, obstacles: &[i32]) -> i32 {
+    let clear = |x: i32| obstacles.iter().all(|&c| c + 8 < x || c - 8 > x + width);
+    let mut edges = obstacles.to_vec();
+    edges.push(right);
+    let gap = edges
+        .iter()
+        .scan(left, |l, &r| {
+            let g = (*l, r);
+            *l = r;
+            Some(g)
+        })
+        .max_by_key(|(l, r)| r - l)
+        .filter(|(l, r)| r - l >= width + 40)
+        .map(|(l, r)| (l + r - width) / 2);
+    [Some(left + 6), gap, Some(right - 6 - width)]
+        .into_iter()
+        .flatten()
+        .find(|&x| clear(x))
+        .unwrap_or(left + 6)
 }
 
 /// Which of the band's 50 % and 90 % levels some friction coefficient did not reach, for
@@ -611,6 +708,80 @@ mod tests {
         let w = &within;
         assert!(joined(&w[i - 1], &w[i]) && joined(&w[i], &w[i + 1]));
         assert_eq!(draw(&within, "within-tol"), plain);
+    }
+
+    /// The SVG text of Fig. 4 drawn from `rows`, through a temp file named by `tag`.
+    fn svg_of(rows: &[CriticalRow], tag: &str) -> String {
+        let path =
+            std::env::temp_dir().join(format!("whirlmap-fig4-{tag}-{}.svg", std::process::id()));
+        let fig = Fig4 {
+            rows,
+            band: None,
+            title: tag.into(),
+        };
+        crate::render::render(&path, (1000, 700), &fig).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::remove_file(&path).ok();
+        text
+    }
+
+    /// Rows of a search from `from` to `to` r/min, as a sweep's `critical.speed_rpm` sets it:
+    /// no whirl at mu 0.3, an onset bracketed at 4375 r/min at 0.4, whirl already at the
+    /// lowest speed at 0.5 (the main job's row at mu 0.05 as the template).
+    fn searched(from: f64, to: f64) -> Vec<CriticalRow> {
+        let (rows, _) = paper_rows_at_mu_0_4();
+        let row = |mu: f64, onset: Option<f64>, bracketed: bool| {
+            let mut r = rows[0].clone();
+            r.mu = mu;
+            r.from_rpm = from;
+            r.to_rpm = to;
+            r.onset_rpm = onset;
+            r.bracket_rpm = onset.filter(|_| bracketed).map(|o| [o - 62.5, o]);
+            r.whirl_intervals_rpm = onset.map(|o| vec![[o, to]]).unwrap_or_default();
+            r.whirl_at_range_top = onset.is_some();
+            r
+        };
+        vec![
+            row(0.3, None, false),
+            row(0.4, Some(4375.0), true),
+            row(0.5, Some(from.max(4000.0)), false),
+        ]
+    }
+
+    /// A search that starts above the speed axis's 0 has its bottom marked as its top is,
+    /// and the speeds below it shaded and named as not searched (they read as speeds without
+    /// whirl); a search from 0 draws neither. The main job's search starts at 1000 r/min.
+    /// The picture of the 4000 to 7000 r/min search is kept under the temp folder when
+    /// `WHIRLMAP_KEEP_CHART` is set, to be looked at.
+    #[test]
+    fn the_bottom_of_a_search_above_zero_is_marked() {
+        let refs = |rows: &[CriticalRow]| -> Option<f64> {
+            searched_bottom(&rows.iter().collect::<Vec<_>>())
+        };
+        let (paper, _) = paper_rows_at_mu_0_4();
+        assert_eq!(refs(&paper), Some(1000.0));
+        let above = searched(4000.0, 7000.0);
+        assert_eq!(refs(&above), Some(4000.0));
+        let svg = svg_of(&above, "bottom-4000");
+        for text in [
+            "bottom of the searched range, 4000 r/min",
+            "top of the searched range, 7000 r/min",
+            "not searched",
+        ] {
+            assert!(svg.contains(text), "{text:?} missing");
+        }
+        drawn(&above, "bottom-4000", "Fig. 4 searched from 4000 r/min");
+
+        let from_zero = searched(0.0, 7000.0);
+        assert_eq!(refs(&from_zero), None);
+        let svg = svg_of(&from_zero, "bottom-0");
+        assert!(svg.contains("top of the searched range, 7000 r/min"));
+        assert!(!svg.contains("bottom of the searched range") && !svg.contains("not searched"));
+        // One row from 0 among rows from 4000: some search ran down to 0.
+        let mut mixed = above.clone();
+        mixed[1].from_rpm = 0.0;
+        assert_eq!(refs(&mixed), None);
+        assert_eq!(refs(&[]), None);
     }
 
     /// A band whose 90 % level one friction coefficient never reaches is drawn open there

@@ -78,6 +78,40 @@ pub(crate) enum CellKind {
     NoValue,
 }
 
+/// The narrowest span a colour scale is stretched over, relative to its values: 1 %. Forces
+/// and heat powers are computed to 0.1 % (the accuracy budget of docs/accuracy.md), so cells
+/// closer than that are the same result, and stretching the whole scale over a map whose
+/// values all lie within a few times the budget paints solver noise as yellow against purple.
+/// Ten times the budget keeps every difference that is a result on the full scale: the floor
+/// only acts on a map whose values all lie within 1 % (the committed maps span 13 % and
+/// more). The other maps take the same floor: at the force's budget a contact pressure moves
+/// less (as the force's cube root) and drops to failure three times more (as its inverse
+/// cube), both still well inside 1 %; a temperature in degrees Celsius gets 1 % of its value
+/// (0.3 K at 30 degrees, 1.5 K at 150), differences no design of the bearing turns on.
+pub(crate) const MIN_RELATIVE_SPAN: f64 = 0.01;
+
+/// The colour scale's ends for values from `lo` to `hi` on the scale's axis (decade exponents
+/// on a log scale): their own range when it spans at least [`MIN_RELATIVE_SPAN`] of their
+/// largest magnitude (on a log scale: of the values, a fixed number of decades), else that
+/// span centred on them, so that near-equal cells take near-equal colours from the middle of
+/// the scale instead of its two ends. Values all zero get the scale -1 to 1.
+pub(crate) fn colour_scale((lo, hi): (f64, f64), log: bool) -> (f64, f64) {
+    let min_span = if log {
+        (1.0 + MIN_RELATIVE_SPAN).log10()
+    } else {
+        match lo.abs().max(hi.abs()) {
+            0.0 => 2.0,
+            m => MIN_RELATIVE_SPAN * m,
+        }
+    };
+    if hi - lo >= min_span {
+        return (lo, hi);
+    }
+    // Halfway from one end, not the ends' sum halved: that overflows near f64::MAX.
+    let mid = lo + (hi - lo) / 2.0;
+    (mid - min_span / 2.0, mid + min_span / 2.0)
+}
+
 /// A quantity drawn in a colour scale.
 #[derive(Clone, Copy)]
 pub(crate) struct Metric {
@@ -218,14 +252,7 @@ impl Figure for GridFigure<'_> {
                 Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
             });
         let data_range = scale;
-        let scale = scale.map(|(lo, hi)| {
-            if hi > lo {
-                (lo, hi)
-            } else {
-                let h = if lo == 0.0 { 1.0 } else { lo.abs() * 0.05 };
-                (lo - h, hi + h)
-            }
-        });
+        let scale = scale.map(|range| colour_scale(range, metric.is_some_and(|m| m.log)));
         let is_metric = matches!(self.mode, GridMode::Metric(_));
 
         let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
@@ -346,7 +373,9 @@ impl Figure for GridFigure<'_> {
         let mut limit_entry = None;
         if let (GridMode::Metric(_), Some((lo, hi))) = (self.mode, scale) {
             let m = metric.expect("a metric mode");
-            if values.len() >= 2 {
+            // No contour levels on a scale widened to its floor: a line between cells that
+            // close would part what the colours show as alike.
+            if values.len() >= 2 && scale == data_range {
                 levels = match m.log {
                     // Whole decades, when the scale spans two or more.
                     true if hi.floor() - lo.ceil() >= 1.0 => (lo.ceil() as i64..=hi.floor() as i64)
@@ -522,8 +551,10 @@ impl Figure for GridFigure<'_> {
                             "forward whirl (hatched the other way)".to_string(),
                         ));
                     }
-                } else {
-                    // The backward-whirl entry is always shown: it is where the scale stops.
+                }
+                // Named only when drawn: an entry for cells the map does not have would read
+                // as if some drops had whirled.
+                if whirl_seen[0] {
                     entries.push((
                         Mark::Hatch(false),
                         "backward whirl (not in colour scale)".to_string(),
@@ -620,7 +651,29 @@ fn connected_pieces(ends: &[[(i32, i32); 2]]) -> Vec<Vec<usize>> {
 
 #[cfg(test)]
 mod tests {
-    use super::{connected_pieces, uneven};
+    use super::{colour_scale, connected_pieces, uneven, MIN_RELATIVE_SPAN};
+
+    /// Values closer than the floor get a scale of the floor's span centred on them; values
+    /// further apart keep their own range; all zero, -1 to 1; on a log scale the floor is a
+    /// fixed number of decades.
+    #[test]
+    fn the_colour_scale_spans_at_least_one_percent_of_its_values() {
+        let (lo, hi) = colour_scale((880.13176, 880.13194), false);
+        assert!((hi - lo - 0.01 * 880.13194).abs() < 1e-9, "{lo} {hi}");
+        assert!(((lo + hi) / 2.0 - 880.13185).abs() < 1e-9, "{lo} {hi}");
+        // The main job's Fig. 5 range, and one just at the floor: their own.
+        assert_eq!(colour_scale((880.0, 1064.0), false), (880.0, 1064.0));
+        assert_eq!(colour_scale((99.0, 100.0), false), (99.0, 100.0));
+        let (lo, hi) = colour_scale((-200.0, -199.5), false);
+        assert!((hi - lo - 2.0).abs() < 1e-9 && ((lo + hi) / 2.0 + 199.75).abs() < 1e-9);
+        assert_eq!(colour_scale((0.0, 0.0), false), (-1.0, 1.0));
+        let (lo, hi) = colour_scale((6.0, 6.0001), true);
+        assert!((hi - lo - (1.0 + MIN_RELATIVE_SPAN).log10()).abs() < 1e-12);
+        assert_eq!(colour_scale((3.0, 6.0), true), (3.0, 6.0));
+        // The largest values a chart keeps stay finite.
+        let (lo, hi) = colour_scale((1e300, 1e300), false);
+        assert!(lo.is_finite() && hi.is_finite() && hi > lo);
+    }
 
     #[test]
     fn uneven_spacing_is_told_from_rounding() {

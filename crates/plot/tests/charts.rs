@@ -393,3 +393,156 @@ fn no_speed_and_friction_map_without_both_axes() {
     assert!(written.is_empty(), "{written:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Writes `points.jsonl` of one drop per `(speed, mu, class, max force, peak heat power)`, a
+/// class of "failed" writing a failed point.
+fn write_points(dir: &Path, points: &[(f64, f64, &str, f64, f64)]) {
+    let lines: Vec<String> = points
+        .iter()
+        .enumerate()
+        .map(|(index, &(speed, mu, class, force, heat))| {
+            let inputs = json!({"speed_rpm": speed, "mu": mu});
+            let line = if class == "failed" {
+                json!({"key": format!("p{index}"), "index": index, "inputs": inputs,
+                       "scene_hash": "abc", "duration_s": 0.3, "model_version": 1,
+                       "status": "failed",
+                       "error": {"kind": "step_size_underflow", "message": "step size underflow"}})
+            } else {
+                json!({"key": format!("p{index}"), "index": index, "inputs": inputs,
+                       "scene_hash": "abc", "duration_s": 0.3, "model_version": 1,
+                       "status": "ok",
+                       "record": {"class": class, "first_contact_force_n": 879.0,
+                                  "max_contact_force_n": force,
+                                  "peak_friction_power_w": heat * 0.9,
+                                  "peak_heat_power_w": heat, "whirl_frequency_hz": 0.0}})
+            };
+            line.to_string()
+        })
+        .collect();
+    std::fs::write(dir.join("points.jsonl"), lines.join("\n") + "\n").unwrap();
+}
+
+/// The fill colours of a map's cells in an SVG chart, in the order drawn (friction slowest):
+/// the filled rectangles 100 px or more on each side (the colour bar is narrower, the
+/// background is the first).
+fn cell_fills(svg: &str) -> Vec<[u8; 3]> {
+    let attr = |tag: &str, name: &str| -> Option<String> {
+        let start = tag.find(&format!(" {name}=\""))? + name.len() + 3;
+        Some(tag[start..].split('"').next()?.to_string())
+    };
+    svg.split("<rect")
+        .skip(2)
+        .filter_map(|tag| {
+            let tag = tag.split('>').next()?;
+            let size = |name| attr(tag, name)?.parse::<u32>().ok();
+            let fill = attr(tag, "fill")?;
+            let hex = fill.strip_prefix('#')?;
+            let channel = |k: usize| u8::from_str_radix(&hex[2 * k..2 * k + 2], 16).ok();
+            (size("width")? >= 100 && size("height")? >= 100)
+                .then(|| Some([channel(0)?, channel(1)?, channel(2)?]))?
+        })
+        .collect()
+}
+
+/// Two pendulum cells 0.00002 % apart (solver noise, far below the 0.1 % accuracy budget)
+/// take alike colours from the middle of the scale: they were drawn one at each end of it, as
+/// if they were the map's lowest and highest results, with a colour bar from 880.1318 to
+/// 880.1319 N. The whirl cells are outside the scale either way. Nor does a contour line
+/// part such cells.
+#[test]
+fn near_equal_cells_are_drawn_alike() {
+    let dir = temp_dir("near-equal");
+    write_points(
+        &dir,
+        &[
+            (4000.0, 0.3, "pendulum", 880.13194, 500.0),
+            (8000.0, 0.3, "pendulum", 880.13176, 500.0001),
+            (4000.0, 0.4, "backward_whirl", 1500.0, 3000.0),
+            (8000.0, 0.4, "backward_whirl", 2000.0, 4000.0),
+        ],
+    );
+    render_all(&dir).unwrap();
+    for stem in ["fig5_max_force", "fig6_peak_power"] {
+        let svg = std::fs::read_to_string(dir.join(format!("charts/{stem}.svg"))).unwrap();
+        let fills = cell_fills(&svg);
+        assert_eq!(fills.len(), 4, "{stem}: {fills:?}");
+        let (a, b) = (fills[0], fills[1]);
+        let apart = (0..3).map(|k| a[k].abs_diff(b[k])).max().unwrap();
+        assert!(apart <= 2, "{stem}: the pendulum cells are {a:?} and {b:?}");
+        // Viridis's middle is teal: green and blue well above red (its ends are dark purple,
+        // blue above green, and yellow, blue low).
+        assert!(
+            a[1] > a[0] + 60 && a[2] > a[0] + 60,
+            "{stem}: {a:?} is not the middle"
+        );
+        assert!(!svg.contains("880.1318"), "{stem}: a bar over the noise");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+
+    // Four such cells either side of a round value: no contour line parts them.
+    let dir = temp_dir("near-equal-contour");
+    let (a, b) = (499.9999, 500.0001);
+    write_points(
+        &dir,
+        &[
+            (4000.0, 0.3, "pendulum", 880.0 - 1e-4, a),
+            (8000.0, 0.3, "pendulum", 880.0 + 1e-4, b),
+            (4000.0, 0.4, "pendulum", 880.0 - 1e-4, a),
+            (8000.0, 0.4, "pendulum", 880.0 + 1e-4, b),
+        ],
+    );
+    render_all(&dir).unwrap();
+    for stem in ["fig5_max_force", "fig6_peak_power"] {
+        let svg = std::fs::read_to_string(dir.join(format!("charts/{stem}.svg"))).unwrap();
+        assert!(
+            !svg.contains("contour lines"),
+            "{stem}: a contour over the noise"
+        );
+        let fills = cell_fills(&svg);
+        assert_eq!(fills.len(), 4, "{stem}: {fills:?}");
+        assert!(fills
+            .iter()
+            .all(|f| f.iter().zip(fills[0]).all(|(x, y)| x.abs_diff(y) <= 2)));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A map without backward-whirl cells does not name them in its legend (it did always, so a
+/// sweep whose every drop failed, or whose drops all settled into pendulum vibration, read as
+/// if some had whirled); one with them still does.
+#[test]
+fn the_whirl_legend_entry_names_only_cells_drawn() {
+    let entry = "backward whirl (not in colour scale)";
+    let grid = |class: [&'static str; 4]| -> Vec<(f64, f64, &'static str, f64, f64)> {
+        vec![
+            (4000.0, 0.3, class[0], 900.0, 500.0),
+            (8000.0, 0.3, class[1], 950.0, 600.0),
+            (4000.0, 0.4, class[2], 1000.0, 700.0),
+            (8000.0, 0.4, class[3], 1100.0, 800.0),
+        ]
+    };
+    let cases = [
+        ("all-failed", grid(["failed"; 4]), false),
+        ("all-pendulum", grid(["pendulum"; 4]), false),
+        (
+            "forward-only",
+            grid(["pendulum", "pendulum", "pendulum", "forward_whirl"]),
+            false,
+        ),
+        (
+            "one-whirl",
+            grid(["pendulum", "pendulum", "pendulum", "backward_whirl"]),
+            true,
+        ),
+    ];
+    for (name, points, named) in cases {
+        let dir = temp_dir(&format!("whirl-legend-{name}"));
+        write_points(&dir, &points);
+        render_all(&dir).unwrap();
+        for stem in ["fig5_max_force", "fig6_peak_power"] {
+            let svg = std::fs::read_to_string(dir.join(format!("charts/{stem}.svg"))).unwrap();
+            assert_eq!(svg.contains(entry), named, "{name}: {stem}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
