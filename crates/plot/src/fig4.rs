@@ -14,7 +14,9 @@
 //!   (`recheck.relocated`);
 //! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
 //!   to the top of the searched range;
-//! - **no whirl in range** as an open triangle at the range top;
+//! - **no whirl in range** as an open triangle at the range top; as an open square there when
+//!   the re-check at a tighter preset whirls at the range top, with that preset's onset, when
+//!   its search below the top found it, as a diamond joined to it;
 //! - the **searched range**: its top as a dashed line with its value, and its bottom (the
 //!   rows' `from_rpm`) the same way when it is above the axis's 0, the speeds below it shaded
 //!   as not searched, so that they do not read as speeds without whirl;
@@ -303,14 +305,43 @@ impl Figure for Fig4<'_> {
             }
         }
 
-        // No whirl in the range: a marker at the range top.
+        // No whirl in the range: a marker at the range top; when the re-check at a tighter
+        // preset whirls there, an open square instead, and that preset's onset, when its
+        // search below the top found it, as a diamond joined to it.
         let mut any_none = false;
+        // The presets whose re-check whirled at the top of a range with no whirl found.
+        let mut none_unconfirmed_at: Vec<&str> = Vec::new();
         for r in rows.iter().filter(|r| r.whirl_intervals_rpm.is_empty()) {
             if r.scan.iter().all(|p| p.class.is_none()) {
                 continue; // nothing decided (every drop failed): nothing to mark
             }
-            any_none = true;
-            triangle_up(&canvas, px(r.mu, clamp_value(r.to_rpm)), 8, NONE_MARK)?;
+            let p = px(r.mu, clamp_value(r.to_rpm));
+            let Some(rc) = r.recheck.as_ref().filter(|rc| !rc.holds() && !r.undecided) else {
+                any_none = true;
+                triangle_up(&canvas, p, 8, NONE_MARK)?;
+                continue;
+            };
+            if !none_unconfirmed_at.contains(&rc.fidelity.name()) {
+                none_unconfirmed_at.push(rc.fidelity.name());
+            }
+            let found = (rc.relocated.as_ref())
+                .and_then(|w| w.onset_rpm)
+                .map(|onset| px(r.mu, clamp_value(onset)));
+            if let Some(q) = found {
+                canvas.draw(&DashedPathElement::new(
+                    vec![p, q],
+                    3,
+                    3,
+                    CONTOUR.mix(0.7).stroke_width(1),
+                ))?;
+                if !relocated_at.contains(&rc.fidelity.name()) {
+                    relocated_at.push(rc.fidelity.name());
+                }
+            }
+            open_square(&canvas, p, 6, NONE_MARK)?;
+            if let Some(q) = found {
+                diamond(&canvas, q, 6, CONTOUR)?;
+            }
         }
         // The top of the searched range, as a faint line with its value above it.
         if let Some(t) = rows.iter().map(|r| clamp_value(r.to_rpm)).reduce(f64::max) {
@@ -410,11 +441,20 @@ impl Figure for Fig4<'_> {
                 ),
             ));
         }
+        if !none_unconfirmed_at.is_empty() {
+            entries.push((
+                Mark::OpenSquare(NONE_MARK),
+                format!(
+                    "no whirl in range, not confirmed at its top by the re-check at {}",
+                    none_unconfirmed_at.join(", ")
+                ),
+            ));
+        }
         if !relocated_at.is_empty() {
             entries.push((
                 Mark::Diamond(CONTOUR),
                 format!(
-                    "onset at {}, searched again near the bracket",
+                    "onset at {}, searched again nearby",
                     relocated_at.join(", ")
                 ),
             ));
@@ -708,6 +748,51 @@ mod tests {
         let w = &within;
         assert!(joined(&w[i - 1], &w[i]) && joined(&w[i], &w[i + 1]));
         assert_eq!(draw(&within, "within-tol"), plain);
+    }
+
+    /// A row with no whirl in its range whose re-check whirls at the range top: an open
+    /// square there instead of the triangle, with its legend entry; with the tighter preset's
+    /// onset found below the top, a diamond too. A confirmed one is drawn as before.
+    #[test]
+    fn no_whirl_not_confirmed_at_the_range_top_is_drawn_apart() {
+        use whirlmap_core::classify::OrbitClass;
+        use whirlmap_core::Fidelity;
+        use whirlmap_results::critical::{Outcome, Recheck, Relocated};
+        let (rows, _) = paper_rows_at_mu_0_4();
+        let i = rows
+            .iter()
+            .position(|r| (r.mu - 0.3).abs() < 1e-9)
+            .expect("mu 0.3");
+        assert!(rows[i].whirl_intervals_rpm.is_empty(), "no whirl at mu 0.3");
+        let top = rows[i].to_rpm;
+        let recheck = |class| Recheck {
+            fidelity: Fidelity::Standard,
+            lo: Some((top, Outcome::Class(class))),
+            hi: None,
+            confirmed: class != OrbitClass::BackwardWhirl,
+            within_tol: false,
+            relocated: None,
+        };
+        let legend = "no whirl in range, not confirmed at its top by the re-check at standard";
+        let plain = svg_of(&rows, "none-plain");
+        let mut confirmed = rows.clone();
+        recheck(OrbitClass::Pendulum).apply_to(&mut confirmed[i]);
+        assert_eq!(svg_of(&confirmed, "none-plain"), plain);
+        let mut unconfirmed = rows.clone();
+        recheck(OrbitClass::BackwardWhirl).apply_to(&mut unconfirmed[i]);
+        let u = svg_of(&unconfirmed, "none-unconfirmed");
+        assert!(u.contains(legend) && !plain.contains(legend), "{u}");
+        assert!(!u.contains("searched again"), "{u}");
+        let mut relocated = unconfirmed.clone();
+        relocated[i].recheck.as_mut().unwrap().relocated = Some(Relocated {
+            window_rpm: [top - 2000.0, top],
+            onset_rpm: Some(top - 1500.0),
+            drops: 8,
+            note: String::new(),
+        });
+        let r = svg_of(&relocated, "none-relocated");
+        assert!(r.contains("onset at standard, searched again"), "{r}");
+        assert!(r.contains(legend), "{r}");
     }
 
     /// The SVG text of Fig. 4 drawn from `rows`, through a temp file named by `tag`.
