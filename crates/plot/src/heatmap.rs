@@ -370,18 +370,21 @@ impl Figure for GridFigure<'_> {
         }
 
         let mut levels = Vec::new();
+        // Whether the levels are whole decades (a log scale spanning two or more).
+        let mut decade_levels = false;
         let mut limit_entry = None;
         if let (GridMode::Metric(_), Some((lo, hi))) = (self.mode, scale) {
             let m = metric.expect("a metric mode");
             // No contour levels on a scale widened to its floor: a line between cells that
             // close would part what the colours show as alike.
             if values.len() >= 2 && scale == data_range {
-                levels = match m.log {
-                    // Whole decades, when the scale spans two or more.
-                    true if hi.floor() - lo.ceil() >= 1.0 => (lo.ceil() as i64..=hi.floor() as i64)
+                decade_levels = m.log && hi.floor() - lo.ceil() >= 1.0;
+                levels = if decade_levels {
+                    (lo.ceil() as i64..=hi.floor() as i64)
                         .map(|d| d as f64)
-                        .collect(),
-                    _ => nice_levels(lo, hi, 6),
+                        .collect()
+                } else {
+                    nice_levels(lo, hi, 6)
                 };
             }
             // With whirl cells in the scale, the whirl runs (stopped after a few turns) and
@@ -523,7 +526,7 @@ impl Figure for GridFigure<'_> {
             }
             GridMode::Metric(m) => {
                 if !levels.is_empty() {
-                    let words = if m.log {
+                    let words = if decade_levels {
                         "contour lines (decades)"
                     } else {
                         "contour lines"

@@ -243,3 +243,29 @@ fn records_without_the_analysis_get_no_bearing_charts() {
     assert!(rows.iter().all(|r| r.drops_to_failure.is_none()));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Drops to failure spanning less than two decades: the contour levels are round values, not
+/// decades, and the legend does not call them decades.
+#[test]
+fn contours_on_a_log_scale_short_of_two_decades_are_not_called_decades() {
+    let dir = folder("bearing-short-span", true, |speed, _| 1.0 + speed / 10000.0);
+    let points = dir.join("points.jsonl");
+    let text = std::fs::read_to_string(&points).unwrap();
+    let lines: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+            let drops = 1e10 * (1.0 + 0.1 * i as f64);
+            v["record"]["drops_to_failure"] = json!(drops);
+            v["record"]["damage_per_drop"] = json!(1.0 / drops);
+            v.to_string()
+        })
+        .collect();
+    std::fs::write(&points, lines.join("\n")).unwrap();
+    render_all(&dir).unwrap();
+    let drops = texts(&dir, "drops_to_failure");
+    assert!(!has(&drops, "contour lines (decades)"), "{drops:?}");
+    assert!(has(&drops, "contour lines"), "{drops:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
