@@ -67,9 +67,12 @@ fn did_you_mean_text(suggestion: Option<&str>) -> String {
 /// or false`); any other message is returned as it is.
 pub fn with_suggestion(message: &str) -> String {
     let message = plain_types(message);
-    let Some(rest) = message.split("unknown field `").nth(1) else {
+    const MARK: &str = "unknown field `";
+    let Some(start) = message.find(MARK).map(|i| i + MARK.len()) else {
         return message;
     };
+    // Split at a char boundary (the marker's end), whatever the key holds.
+    let (head, rest) = message.split_at(start);
     let Some((given, tail)) = rest.split_once('`') else {
         return message;
     };
@@ -80,7 +83,6 @@ pub fn with_suggestion(message: &str) -> String {
     // The suggestion first, beside the misspelt key, and the position before the long list
     // of known keys: `unknown field `clearence_m` (did you mean `clearance_m`?) at line 1
     // column 14; expected one of ...`.
-    let head = &message[..message.len() - rest.len()];
     let list = tail.trim_start_matches(", ");
     match list.rfind(" at line ") {
         Some(at) => format!(
@@ -134,8 +136,15 @@ pub fn apply_assignment(scene: &mut Scene, assignment: &str) -> Result<(), Overr
             });
         }
     }
-    let value: Value =
+    let mut value: Value =
         serde_json::from_str(text).unwrap_or_else(|_| Value::String(text.to_string()));
+    // `-0` is 0, as the number flags read it: echoed and hashed as 0.
+    if value
+        .as_f64()
+        .is_some_and(|x| x == 0.0 && x.is_sign_negative())
+    {
+        value = Value::from(0.0);
+    }
     apply(scene, key, value)
 }
 
@@ -502,6 +511,16 @@ mod tests {
     }
 
     #[test]
+    fn minus_zero_is_set_as_zero() {
+        let mut s = Scene::paper();
+        apply_assignment(&mut s, "speed_rpm=-0.0").unwrap();
+        assert!(s.speed_rpm == 0.0 && s.speed_rpm.is_sign_positive());
+        let mut z = Scene::paper();
+        apply_assignment(&mut z, "speed_rpm=0").unwrap();
+        assert_eq!(s.hash_hex(), z.hash_hex());
+    }
+
+    #[test]
     fn a_misspelt_key_gets_the_closest_known_one() {
         let mut s = Scene::paper();
         let e = apply_assignment(&mut s, "clearence_m=1e-4").unwrap_err();
@@ -519,6 +538,13 @@ mod tests {
         // serde's message for a scene or sweep file
         let text = r#"{"clearence_m": 1e-4}"#;
         let err = whirlmap_core::json::from_str::<Scene>(text).unwrap_err();
+        // A key holding backticks, the marker and non-ASCII text: no panic, the text kept.
+        let odd = format!(
+            "unknown field `clearence_m` `clearance_m` {} unknown field `x`, expected one of \
+             `clearance_m`, `mu_dynamic` at line 1 column 9",
+            "é".repeat(600)
+        );
+        assert!(with_suggestion(&odd).contains(&"é".repeat(600)));
         let m = with_suggestion(&err.to_string());
         assert!(
             m.starts_with(
