@@ -274,6 +274,7 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
     for r in rows {
         outln!();
         outln!("  mu_d = {}", r.mu);
+        let not_confirmed = r.recheck.as_ref().is_some_and(|rc| !rc.holds());
         match (r.onset_rpm, r.bracket_rpm) {
             (Some(o), Some([lo, hi])) => outln!(
                 "    onset of whirl      {} r/min (bracket {}-{}{})",
@@ -282,7 +283,7 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                 fmt_rpm(hi),
                 if r.undecided {
                     ", UNDECIDED: failed drops below it"
-                } else if r.recheck.as_ref().is_some_and(|rc| !rc.holds()) {
+                } else if not_confirmed {
                     ", NOT CONFIRMED by the re-check"
                 } else if r.converged {
                     ""
@@ -295,11 +296,16 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                 fmt_rpm(o),
                 if r.undecided {
                     "; UNDECIDED: failed drops below it"
+                } else if not_confirmed {
+                    "; NOT CONFIRMED by the re-check"
                 } else {
                     ""
                 }
             ),
             _ if r.undecided => outln!("    onset of whirl      UNDECIDED (failed drops)"),
+            _ if not_confirmed => {
+                outln!("    onset of whirl      none in the range, NOT CONFIRMED by the re-check")
+            }
             _ => outln!("    onset of whirl      none in the range"),
         }
         outln!(

@@ -523,6 +523,15 @@ fn a_row_without_a_bracket_is_re_checked_at_the_end_that_decides_it() {
         "{row}"
     );
     assert!(note.contains("where the search found no whirl"), "{note}");
+    // The table says it in the row's headline too.
+    let table: Vec<&str> = args.iter().copied().filter(|a| *a != "--json").collect();
+    let o = whirlmap(&table);
+    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    assert!(
+        out(&o).contains("none in the range, NOT CONFIRMED by the re-check"),
+        "{}",
+        out(&o)
+    );
 }
 
 #[test]

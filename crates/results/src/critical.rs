@@ -232,12 +232,14 @@ pub struct Recheck {
     /// The preset the cells were re-run at.
     pub fidelity: Fidelity,
     /// Lower bracket speed (r/min) and its outcome at that preset; for a row that found no
-    /// whirl, its highest speed scanned. Absent for a row whose whirl starts at the lowest
-    /// speed scanned.
+    /// whirl, its highest speed scanned with a class (the range top unless that drop failed).
+    /// Absent for a row whose whirl starts at the lowest speed scanned.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lo: Option<(f64, Outcome)>,
     /// Upper bracket speed (r/min) and its outcome at that preset; for a row whose whirl
-    /// starts at the lowest speed scanned, that speed. Absent for a row that found no whirl.
+    /// starts at the lowest speed scanned with a class, that speed. Absent for a row that
+    /// found no whirl. (A row with either one absent cannot be read by a build from before
+    /// rows without a bracket were re-checked.)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hi: Option<(f64, Outcome)>,
     /// True when the tighter preset agrees at the cells re-run: a settled class other than
@@ -251,16 +253,17 @@ pub struct Recheck {
     /// when true; absent reads as false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub within_tol: bool,
-    /// Where the tighter preset puts the onset, when it does not confirm the bracket.
+    /// Where the tighter preset puts the onset, when it does not confirm the cells.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub relocated: Option<Relocated>,
 }
 
 /// The search run again at the re-check's tighter preset when that preset does not confirm
-/// the bracket, on the search's lattice and tolerance, from two lattice steps below the
-/// lattice point under the bracket to two above the one over it (within the range
-/// searched), each side widened, doubling its steps up to sixteen, while the onset lies beyond
-/// it: where that preset puts the onset.
+/// the cells re-run, on the search's lattice and tolerance, from two lattice steps below the
+/// lattice point under the lower cell to two above the one over the upper (the bracket's
+/// ends, or twice the end of the range that decides a row without a bracket; within the
+/// range searched), each side widened, doubling its steps up to sixteen, while the onset lies
+/// beyond it: where that preset puts the onset.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Relocated {
     /// The window searched last, the widest (r/min), on the search's lattice and bisection

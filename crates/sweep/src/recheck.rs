@@ -28,7 +28,7 @@ pub use whirlmap_results::critical::{Recheck, Relocated};
 /// Re-runs the cells that decide `row` ([`deciding_cells`]; searched on `scene`, whose
 /// `mu_dynamic` is set) at `tighter`, at once; `None` when nothing was decided (every scan
 /// drop failed).
-pub fn recheck_bracket(
+pub fn recheck_row(
     scene: &Scene,
     row: &CriticalRow,
     tighter: Fidelity,
@@ -43,7 +43,7 @@ pub fn recheck_bracket(
     )
 }
 
-/// Re-checks every row ([`recheck_bracket`]) at `tighter`, the rows at once, each
+/// Re-checks every row ([`recheck_row`]) at `tighter`, the rows at once, each
 /// on `base` with the row's friction coefficient, and records each in its row
 /// ([`Recheck::apply_to`]: an onset that does not hold there leaves the row not converged).
 /// With `cancel`, a drop not yet started when it is raised is skipped (its outcome
@@ -89,7 +89,7 @@ pub fn recheck_rows(
     });
 }
 
-/// The re-check of [`recheck_bracket`] with `run` for a drop. `ticker`, whose count `run`
+/// The re-check of [`recheck_row`] with `run` for a drop. `ticker`, whose count `run`
 /// ticks, is told of a window search's drops as they are planned.
 fn recheck_with(
     scene: &Scene,
@@ -152,11 +152,12 @@ fn cells_len((lo, hi): (Option<f64>, Option<f64>)) -> usize {
     usize::from(lo.is_some()) + usize::from(hi.is_some())
 }
 
-/// Lattice steps either side of the bracket that [`relocate`] searches first: the convergence
+/// Lattice steps either side of the cells re-run that [`relocate`] searches first: the convergence
 /// study's tolerance on an onset (docs/accuracy.md).
 const WINDOW_STEPS: f64 = 2.0;
 
-/// Lattice steps either side of the bracket that [`relocate`] widens its window to, at most.
+/// Lattice steps either side of the cells re-run that [`relocate`] widens its window to, at
+/// most.
 const MAX_WINDOW_STEPS: f64 = 16.0;
 
 /// Searches `row`'s deciding cells `[lo, hi]` (its bracket, or twice the end of the range
