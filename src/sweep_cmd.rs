@@ -125,9 +125,11 @@ pub(crate) fn report_failed(out_dir: &Path, failed: usize) {
         return;
     }
     let path = out_dir.join(whirlmap_sweep::results::files::POINTS_FILE);
-    match std::fs::read_to_string(&path) {
-        Ok(text) => {
-            if let Some(s) = whirlmap_sweep::results::summary::failure_summary(&text) {
+    match std::fs::File::open(&path) {
+        Ok(f) => {
+            // Line by line: the file is as long as the grid.
+            let lines = std::io::BufRead::lines(std::io::BufReader::new(f)).map_while(Result::ok);
+            if let Some(s) = whirlmap_sweep::results::summary::failure_summary(lines) {
                 errln!(
                     "error: {s} (every failed point's error is in points.jsonl and summary.csv)"
                 );

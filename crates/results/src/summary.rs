@@ -201,20 +201,29 @@ pub fn csv_field(s: &str) -> String {
     }
 }
 
-/// The failed points of a sweep's `points.jsonl` text, in words: how many failed of how
+/// The failed points of a sweep's `points.jsonl` lines, in words: how many failed of how
 /// many, by error kind (most first), and the first failed point's index, inputs and message:
 /// `3 of 4 points failed (event_budget 2, step_budget 1); the first, index 0 (speed_rpm
 /// 6000, mu 0.2): event budget of 20 mode switches exhausted at t = 0.0188 s`. `None` when
-/// no line is a failed point. Lines that are not records are skipped.
-pub fn failure_summary(points_jsonl: &str) -> Option<String> {
+/// no line is a failed point. Lines that are not records are skipped. Streams: only a line
+/// that may be a failed point's is parsed, so a long grid costs no memory.
+pub fn failure_summary<S: AsRef<str>>(lines: impl IntoIterator<Item = S>) -> Option<String> {
     let mut kinds: std::collections::BTreeMap<String, usize> = Default::default();
     let (mut total, mut failed) = (0usize, 0usize);
     let mut first: Option<String> = None;
-    for line in points_jsonl.lines() {
+    for line in lines {
+        let line = line.as_ref();
+        // Records are written compactly: a point's line holds `"status":` once.
+        if !line.contains("\"status\":") {
+            continue;
+        }
+        total += 1;
+        if !line.contains("\"status\":\"failed\"") {
+            continue;
+        }
         let Ok(v) = serde_json::from_str::<serde_json::Value>(line) else {
             continue;
         };
-        total += 1;
         if v["status"] != "failed" {
             continue;
         }
@@ -303,13 +312,13 @@ mod failure_tests {
         ]
         .join("\n");
         assert_eq!(
-            failure_summary(&text).as_deref(),
+            failure_summary(text.lines()).as_deref(),
             Some(
                 "3 of 4 points failed (step_budget 2, event_budget 1); the first, index 0 \
                  (speed_rpm 6000, mu 0.2): event budget of 20 mode switches exhausted"
             )
         );
-        assert_eq!(failure_summary(r#"{"index":0,"status":"ok"}"#), None);
-        assert_eq!(failure_summary(""), None);
+        assert_eq!(failure_summary([r#"{"index":0,"status":"ok"}"#]), None);
+        assert_eq!(failure_summary([""]), None);
     }
 }
