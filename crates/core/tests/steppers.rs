@@ -734,3 +734,59 @@ fn the_implicit_steppers_interpolants_keep_their_order() {
     // RADAU5's Hermite interpolant, as RODAS4's: O(h^4) at the midpoints.
     assert!((radau5 - 4.0).abs() < 0.4, "RADAU5: {radau5:.2}");
 }
+
+/// Van der Pol's oscillator with stiffness 1e-3: y0' = y1, y1' = ((1 - y0^2) y1 - y0) / 1e-3,
+/// a standard stiff test (Hairer and Wanner, IV.10), whose relaxation jumps change the error
+/// from step to step.
+struct VanDerPol;
+const VDP_EPS: f64 = 1e-3;
+impl OdeSystem<2> for VanDerPol {
+    type Guard = NoGuard;
+    fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+        dy[0] = y[1];
+        dy[1] = ((1.0 - y[0] * y[0]) * y[1] - y[0]) / VDP_EPS;
+    }
+    fn stiff_jacobian(&self, _t: f64, y: &[f64; 2]) -> Option<StiffJacobian> {
+        let mut s = StiffJacobian::over(&[0, 1]);
+        s.jac[(0, 1)] = 1.0;
+        s.jac[(1, 0)] = (-2.0 * y[0] * y[1] - 1.0) / VDP_EPS;
+        s.jac[(1, 1)] = (1.0 - y[0] * y[0]) / VDP_EPS;
+        Some(s)
+    }
+}
+
+/// RADAU5's predictive step-size controller on Van der Pol (to t = 2 from (2, -0.66), rtol =
+/// atol = 1e-6): measured 12 rejected steps in 461 with it and 66 in 448 without, so more
+/// than 30 says the controller is gone. Its end state agrees with RODAS4's to 1e-5.
+#[test]
+fn radau5_predicts_the_step_on_van_der_pol() {
+    let ctl = StepControl {
+        rtol: 1e-6,
+        atol: [1e-6; 2],
+        h_min: 1e-14,
+        max_attempts: 1_000_000,
+        fixed_step: None,
+    };
+    let run = |st: &mut dyn FnMut(&mut f64, &mut [f64; 2]) -> whirlmap_core::ode::Stats| {
+        let (mut t, mut y) = (0.0, [2.0, -0.66]);
+        let stats = st(&mut t, &mut y);
+        assert_eq!(t, 2.0);
+        (y, stats)
+    };
+    let mut radau5 = Radau5::new(ctl);
+    let (y, stats) = run(&mut |t, y| {
+        integrate(&VanDerPol, &mut radau5, t, y, 2.0, &mut NoObserver).unwrap();
+        radau5.stats()
+    });
+    let mut rodas4 = Rodas4::new(ctl);
+    let (y4, _) = run(&mut |t, y| {
+        integrate(&VanDerPol, &mut rodas4, t, y, 2.0, &mut NoObserver).unwrap();
+        rodas4.stats()
+    });
+    println!("RADAU5 on Van der Pol: {stats:?}");
+    assert!(stats.rejected <= 30, "{stats:?}");
+    assert!(
+        (y[0] - y4[0]).abs() < 1e-5 && (y[1] - y4[1]).abs() < 1e-5,
+        "{y:?} {y4:?}"
+    );
+}

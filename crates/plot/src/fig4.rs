@@ -15,8 +15,9 @@
 //! - every **whirl interval** as a translucent bar, with an upward arrow where whirl goes on
 //!   to the top of the searched range;
 //! - **no whirl in range** as an open triangle at the range top; as an open square there when
-//!   the re-check at a tighter preset whirls at the range top, with that preset's onset, when
-//!   its search below the top found it, as a diamond joined to it;
+//!   the re-check at a tighter preset does not confirm it (whirl, or a failed or unsettled
+//!   drop, at the range top), with that preset's onset, when its search below the top found
+//!   it, as a diamond joined to it;
 //! - the **searched range**: its top as a dashed line with its value, and its bottom (the
 //!   rows' `from_rpm`) the same way when it is above the axis's 0, the speeds below it shaded
 //!   as not searched, so that they do not read as speeds without whirl;
@@ -306,7 +307,7 @@ impl Figure for Fig4<'_> {
         }
 
         // No whirl in the range: a marker at the range top; when the re-check at a tighter
-        // preset whirls there, an open square instead, and that preset's onset, when its
+        // preset does not confirm it there, an open square instead, and that preset's onset, when its
         // search below the top found it, as a diamond joined to it.
         let mut any_none = false;
         // The presets whose re-check whirled at the top of a range with no whirl found.
@@ -758,7 +759,10 @@ mod tests {
         use whirlmap_core::classify::OrbitClass;
         use whirlmap_core::Fidelity;
         use whirlmap_results::critical::{Outcome, Recheck, Relocated};
-        let (rows, _) = paper_rows_at_mu_0_4();
+        let (mut rows, _) = paper_rows_at_mu_0_4();
+        // mu 0.3 the only row without whirl: the triangle's legend entry says whether one is
+        // drawn.
+        rows.retain(|r| !r.whirl_intervals_rpm.is_empty() || (r.mu - 0.3).abs() < 1e-9);
         let i = rows
             .iter()
             .position(|r| (r.mu - 0.3).abs() < 1e-9)
@@ -782,6 +786,9 @@ mod tests {
         recheck(OrbitClass::BackwardWhirl).apply_to(&mut unconfirmed[i]);
         let u = svg_of(&unconfirmed, "none-unconfirmed");
         assert!(u.contains(legend) && !plain.contains(legend), "{u}");
+        // The square replaces the triangle.
+        let triangle = |svg: &str| svg.lines().any(|l| l.trim() == "no whirl in range");
+        assert!(triangle(&plain) && !triangle(&u), "{u}");
         assert!(!u.contains("searched again"), "{u}");
         let mut relocated = unconfirmed.clone();
         relocated[i].recheck.as_mut().unwrap().relocated = Some(Relocated {

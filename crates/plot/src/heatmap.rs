@@ -107,9 +107,17 @@ pub(crate) fn colour_scale((lo, hi): (f64, f64), log: bool) -> (f64, f64) {
     if hi - lo >= min_span {
         return (lo, hi);
     }
-    // Halfway from one end, not the ends' sum halved: that overflows near f64::MAX.
+    // Halfway from one end, not the ends' sum halved: that overflows near f64::MAX; and
+    // within half the span of f64::MAX the scale is moved inward to stay finite.
     let mid = lo + (hi - lo) / 2.0;
-    (mid - min_span / 2.0, mid + min_span / 2.0)
+    let (a, b) = (mid - min_span / 2.0, mid + min_span / 2.0);
+    if b.is_infinite() {
+        (f64::MAX - min_span, f64::MAX)
+    } else if a.is_infinite() {
+        (-f64::MAX, -f64::MAX + min_span)
+    } else {
+        (a, b)
+    }
 }
 
 /// A quantity drawn in a colour scale.
@@ -674,8 +682,13 @@ mod tests {
         assert!((hi - lo - (1.0 + MIN_RELATIVE_SPAN).log10()).abs() < 1e-12);
         assert_eq!(colour_scale((3.0, 6.0), true), (3.0, 6.0));
         // The largest values a chart keeps stay finite.
-        let (lo, hi) = colour_scale((1e300, 1e300), false);
-        assert!(lo.is_finite() && hi.is_finite() && hi > lo);
+        for v in [1e300, f64::MAX, -f64::MAX] {
+            let (lo, hi) = colour_scale((v, v), false);
+            assert!(
+                lo.is_finite() && hi.is_finite() && hi > lo,
+                "{v}: {lo} {hi}"
+            );
+        }
     }
 
     #[test]

@@ -22,11 +22,12 @@ pub(super) struct StepLaw {
     pub fac_min: f64,
     /// Largest growth of one accepted step (h_new <= fac_max h).
     pub fac_max: f64,
-    /// Gustafsson's predictive controller (Hairer-Wanner II, IV.8, as RADAU5 has it): after
-    /// the second accepted step since a restart, the next step is also at most
-    /// `h_acc / h * (err^2 / err_acc)^expo / safe` of the law's step, where `h_acc` and
-    /// `err_acc` are the previous accepted step and its norm (floored at 1e-2). It shortens
-    /// the step where the error grows from step to step, before a rejection does.
+    /// Gustafsson's predictive controller (Hairer-Wanner II, IV.8, as RADAU5 has it): from
+    /// the second accepted step since a restart, the next step is also at most `h / gus`,
+    /// with `gus = h_acc / h * (err^2 / err_acc)^expo / safe` clamped as the law's factor is,
+    /// where `h_acc` and `err_acc` are the previous accepted step and its norm (floored at
+    /// 1e-2). It shortens the step where the error grows from step to step, before a
+    /// rejection does.
     pub predictive: bool,
 }
 
