@@ -31,9 +31,10 @@ pub(crate) fn whole<T: TryFrom<u64> + Clone + Send + Sync + 'static>(
 ) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static {
     move |text: &str| {
         let range = format!("[{lo}, {hi}]");
-        match text.trim().parse::<u64>() {
-            Ok(n) if (lo..=hi).contains(&n) => {
-                T::try_from(n).map_err(|_| format!("{n} is too large; allowed {range}"))
+        // Read wide, so a negative or huge whole number is out of range, not "not whole".
+        match text.trim().parse::<i128>() {
+            Ok(n) if (i128::from(lo)..=i128::from(hi)).contains(&n) => {
+                T::try_from(n as u64).map_err(|_| format!("{n} is too large; allowed {range}"))
             }
             Ok(n) => Err(format!("{n} is out of range; allowed {range}")),
             Err(_) => Err(format!("not a whole number; allowed {range}")),
@@ -195,7 +196,13 @@ mod tests {
             threads("1.5").unwrap_err(),
             format!("not a whole number; allowed [1, {}]", crate::MAX_THREADS)
         );
-        assert_eq!(threads("-1").unwrap_err(), threads("x").unwrap_err());
+        assert_eq!(
+            threads("-1").unwrap_err(),
+            format!("-1 is out of range; allowed [1, {}]", crate::MAX_THREADS)
+        );
+        assert!(threads("99999999999999999999999")
+            .unwrap_err()
+            .contains("out of range"));
         assert_eq!(shard("0"), Ok(0));
         assert!(shards("0").unwrap_err().contains("out of range"));
         assert_eq!(shards(&MAX_SHARDS.to_string()), Ok(MAX_SHARDS));

@@ -496,7 +496,7 @@ fn number_flags_given_text_name_their_range() {
         ),
         (
             &["sweep", "sweeps/paper.json", "--threads", "-1"],
-            "not a whole number; allowed [1, 4096]",
+            "-1 is out of range; allowed [1, 4096]",
         ),
         (
             &["sweep", "sweeps/paper.json", "--threads", "0"],

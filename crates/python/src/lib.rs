@@ -47,11 +47,15 @@ pyo3::create_exception!(
 /// `PermissionError`, ...); any other spec error: a `ValueError`.
 fn spec_error(e: spec::SpecError) -> PyErr {
     match &e {
-        spec::SpecError::Read { path, source } => PyOSError::new_err((
-            source.raw_os_error().unwrap_or(0),
-            e.to_string(),
-            path.display().to_string(),
-        )),
+        // Python's message then reads `[Errno 2] cannot read sweep spec (entity not found):
+        // 'path'`. A file that is not text (no errno) is bad input: a ValueError.
+        spec::SpecError::Read { path, source } if source.raw_os_error().is_some() => {
+            PyOSError::new_err((
+                source.raw_os_error(),
+                format!("cannot read sweep spec ({})", source.kind()),
+                path.display().to_string(),
+            ))
+        }
         _ => value_error(e),
     }
 }
