@@ -275,20 +275,9 @@ impl Figure for Fig4<'_> {
                 let found = (rc.relocated.as_ref())
                     .and_then(|w| w.onset_rpm)
                     .map(|onset| px(*mu, clamp_value(onset)));
-                if let Some(q) = found {
-                    canvas.draw(&DashedPathElement::new(
-                        vec![p, q],
-                        3,
-                        3,
-                        CONTOUR.mix(0.7).stroke_width(1),
-                    ))?;
-                    if !relocated_at.contains(&rc.fidelity.name()) {
-                        relocated_at.push(rc.fidelity.name());
-                    }
-                }
-                open_square(&canvas, p, 6, BAND)?;
-                if let Some(q) = found {
-                    diamond(&canvas, q, 6, CONTOUR)?;
+                not_confirmed(&canvas, p, found, BAND)?;
+                if found.is_some() && !relocated_at.contains(&rc.fidelity.name()) {
+                    relocated_at.push(rc.fidelity.name());
                 }
             } else if r.undecided {
                 // Failed drops could move this onset: an open circle.
@@ -328,20 +317,9 @@ impl Figure for Fig4<'_> {
             let found = (rc.relocated.as_ref())
                 .and_then(|w| w.onset_rpm)
                 .map(|onset| px(r.mu, clamp_value(onset)));
-            if let Some(q) = found {
-                canvas.draw(&DashedPathElement::new(
-                    vec![p, q],
-                    3,
-                    3,
-                    CONTOUR.mix(0.7).stroke_width(1),
-                ))?;
-                if !relocated_at.contains(&rc.fidelity.name()) {
-                    relocated_at.push(rc.fidelity.name());
-                }
-            }
-            open_square(&canvas, p, 6, NONE_MARK)?;
-            if let Some(q) = found {
-                diamond(&canvas, q, 6, CONTOUR)?;
+            not_confirmed(&canvas, p, found, NONE_MARK)?;
+            if found.is_some() && !relocated_at.contains(&rc.fidelity.name()) {
+                relocated_at.push(rc.fidelity.name());
             }
         }
         // The top of the searched range, as a faint line with its value above it.
@@ -504,6 +482,30 @@ fn searched_bottom(rows: &[&CriticalRow]) -> Option<f64> {
         .filter(|f| f.is_finite())
         .reduce(f64::min)
         .filter(|&f| f > AXIS_BOTTOM_RPM)
+}
+
+/// Draws what the re-check at a tighter preset did not confirm, at pixel `p`: an open square
+/// in `colour`, and where that preset puts the onset, when its search found it (`found`): a
+/// diamond, joined to the square by a dotted line.
+fn not_confirmed<DB: DrawingBackend>(
+    canvas: &DrawingArea<DB, Shift>,
+    p: (i32, i32),
+    found: Option<(i32, i32)>,
+    colour: RGBColor,
+) -> DrawResult<DB> {
+    if let Some(q) = found {
+        canvas.draw(&DashedPathElement::new(
+            vec![p, q],
+            3,
+            3,
+            CONTOUR.mix(0.7).stroke_width(1),
+        ))?;
+    }
+    open_square(canvas, p, 6, colour)?;
+    if let Some(q) = found {
+        diamond(canvas, q, 6, CONTOUR)?;
+    }
+    Ok(())
 }
 
 /// Draws an end of the searched range across the chart, from `a` to `b`: a faint dashed line.
