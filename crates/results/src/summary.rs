@@ -208,6 +208,15 @@ pub fn csv_field(s: &str) -> String {
 /// no line is a failed point. Lines that are not records are skipped. Streams: only a line
 /// that may be a failed point's is parsed, so a long grid costs no memory.
 pub fn failure_summary<S: AsRef<str>>(lines: impl IntoIterator<Item = S>) -> Option<String> {
+    // What a failed point's line says of it (`PointRecord`'s fields, the inputs in the axes'
+    // order).
+    #[derive(Deserialize)]
+    struct Failed {
+        index: usize,
+        inputs: crate::point::Inputs,
+        status: crate::point::Status,
+        error: Option<crate::point::PointError>,
+    }
     let mut kinds: std::collections::BTreeMap<String, usize> = Default::default();
     let (mut total, mut failed) = (0usize, 0usize);
     let mut first: Option<String> = None;
@@ -221,29 +230,24 @@ pub fn failure_summary<S: AsRef<str>>(lines: impl IntoIterator<Item = S>) -> Opt
         if !line.contains("\"status\":\"failed\"") {
             continue;
         }
-        let Ok(v) = serde_json::from_str::<serde_json::Value>(line) else {
+        let Ok(f) = serde_json::from_str::<Failed>(line) else {
             continue;
         };
-        if v["status"] != "failed" {
+        if f.status != crate::point::Status::Failed {
             continue;
         }
         failed += 1;
-        let error = &v["error"];
-        let kind = error["kind"].as_str().unwrap_or("unknown");
+        let kind = f.error.as_ref().map_or("unknown", |e| e.kind.as_str());
         *kinds.entry(kind.to_string()).or_insert(0) += 1;
         if first.is_none() {
-            let inputs = inputs_in_order(line)
-                .iter()
-                .map(|(k, x)| match x.as_f64() {
-                    Some(x) => format!("{k} {}", whirlmap_core::scene::num(x)),
-                    None => format!("{k} {x}"),
-                })
+            let inputs = (f.inputs.0.iter())
+                .map(|(k, x)| format!("{k} {}", whirlmap_core::scene::num(*x)))
                 .collect::<Vec<_>>()
                 .join(", ");
-            let message = error["message"].as_str().unwrap_or(kind);
+            let message = f.error.as_ref().map_or(kind, |e| e.message.as_str());
             first = Some(format!(
                 "the first, index {} ({inputs}): {message}",
-                v["index"]
+                f.index
             ));
         }
     }
@@ -258,43 +262,6 @@ pub fn failure_summary<S: AsRef<str>>(lines: impl IntoIterator<Item = S>) -> Opt
     Some(format!(
         "{failed} of {total} points failed ({by_kind}); {first}"
     ))
-}
-
-/// A record line's `inputs` in the order written (the sweep's axes), which a
-/// `serde_json::Map` would sort by name.
-fn inputs_in_order(line: &str) -> Vec<(String, serde_json::Value)> {
-    /// The pairs of a JSON object, in order.
-    struct Pairs(Vec<(String, serde_json::Value)>);
-    impl<'de> Deserialize<'de> for Pairs {
-        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-            struct V;
-            impl<'de> serde::de::Visitor<'de> for V {
-                type Value = Pairs;
-                fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                    f.write_str("an object")
-                }
-                fn visit_map<A: serde::de::MapAccess<'de>>(
-                    self,
-                    mut m: A,
-                ) -> Result<Pairs, A::Error> {
-                    let mut v = Vec::new();
-                    while let Some(pair) = m.next_entry()? {
-                        v.push(pair);
-                    }
-                    Ok(Pairs(v))
-                }
-            }
-            d.deserialize_map(V)
-        }
-    }
-    #[derive(Deserialize)]
-    struct Line {
-        inputs: Option<Pairs>,
-    }
-    serde_json::from_str::<Line>(line)
-        .ok()
-        .and_then(|l| l.inputs)
-        .map_or_else(Vec::new, |p| p.0)
 }
 
 #[cfg(test)]

@@ -114,8 +114,16 @@ fn recheck_with(
     let relocated = (!confirmed).then(|| {
         let known: Vec<(f64, &Outcome)> =
             out_lo.iter().chain(&out_hi).map(|(v, o)| (*v, o)).collect();
-        let ends = [lo, hi].map(|v| v.or(lo).or(hi).expect("a row has a deciding cell"));
-        relocate(&s, row, ends, &known, run, ticker)
+        // A row without a bracket has one cell: the window is searched around it.
+        let one = "a row has a deciding cell";
+        relocate(
+            &s,
+            row,
+            [lo.or(hi).expect(one), hi.or(lo).expect(one)],
+            &known,
+            run,
+            ticker,
+        )
     });
     let mut rc = Recheck {
         fidelity: tighter,
@@ -152,8 +160,8 @@ fn cells_len((lo, hi): (Option<f64>, Option<f64>)) -> usize {
     usize::from(lo.is_some()) + usize::from(hi.is_some())
 }
 
-/// Lattice steps either side of the cells re-run that [`relocate`] searches first: the convergence
-/// study's tolerance on an onset (docs/accuracy.md).
+/// Lattice steps either side of the cells re-run that [`relocate`] searches first: the
+/// convergence study's tolerance on an onset (docs/accuracy.md).
 const WINDOW_STEPS: f64 = 2.0;
 
 /// Lattice steps either side of the cells re-run that [`relocate`] widens its window to, at
