@@ -361,12 +361,13 @@ fn failed_drops_that_leave_the_onset_undecided_exit_1_with_every_row_written() {
     assert!(!err.contains("mu 0.45"), "{err}");
 }
 
-/// A `draft` search whose onset the re-check at `standard` does not confirm (standard whirls
-/// on both sides of the draft bracket, near the paper's onset of about 11 500 r/min at
-/// mu 0.25): every row printed, and exit 1 with the coefficient and what the re-check found.
-/// The onset the re-check then finds near the bracket is the one a search at `standard` over
-/// the whole range finds (the lattice is the same, and a search does not depend on its
-/// range). A confirmed re-check exits 0.
+/// A `draft` search whose onset the re-check at `standard` does not confirm: at mu 0.25
+/// `draft` brackets the onset at 11 390.6-11 406.25 r/min, where `standard` gives pendulum
+/// on both sides (its onset is 62.5 r/min higher, more than the 25 r/min tolerance): every
+/// row printed, and exit 1 with the coefficient and what the re-check found. The onset the
+/// re-check then finds near the bracket is the one a search at `standard` over the whole
+/// range finds (the lattice is the same, and a search does not depend on its range). A
+/// confirmed re-check exits 0.
 #[test]
 fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
     let args = [
@@ -375,13 +376,13 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
         "--mu",
         "0.25",
         "--from",
-        "2000",
+        "10000",
         "--to",
-        "16000",
+        "13000",
         "--resolution-rpm",
-        "1000",
+        "250",
         "--tol-rpm",
-        "100",
+        "25",
         "--fidelity",
         "draft",
         "--no-progress",
@@ -400,19 +401,19 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
     let err = stderr(&o);
     assert!(
         err.contains("does not confirm the onset at mu 0.25 (at standard:")
-            && err.contains("backward_whirl"),
+            && err.contains("pendulum"),
         "{err}"
     );
     // Where `standard` puts the onset: searched two lattice steps either side of the
     // bracket, and the same as a `standard` search of the whole range finds.
     let relocated = &rows[0]["recheck"]["relocated"];
     let [lo, hi] = [0, 1].map(|i| rows[0]["bracket_rpm"][i].as_f64().unwrap());
-    // From two lattice steps below the lattice point under the bracket to two above the one
-    // over it (here the range top).
-    assert!(lo > 13000.0 && hi <= 14000.0, "{lo} {hi}");
+    // From two lattice steps below the lattice point under the bracket (11 250) to two
+    // above the one over it (11 500).
+    assert!(lo > 11250.0 && hi <= 11500.0, "{lo} {hi}");
     assert_eq!(
         relocated["window_rpm"],
-        serde_json::json!([11000.0, 16000.0])
+        serde_json::json!([10750.0, 12000.0])
     );
     let mut standard = args.to_vec();
     standard.truncate(args.len() - 3); // no `--fidelity draft`: the scene's numerics
@@ -423,8 +424,8 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
     let onset = full[0]["onset_rpm"].as_f64().expect("an onset at standard");
     assert_eq!(relocated["onset_rpm"].as_f64(), Some(onset), "{rows}");
     assert!(
-        onset < lo,
-        "standard's onset {onset} lies below the draft bracket"
+        onset > hi,
+        "standard's onset {onset} lies above the draft bracket"
     );
     assert!(
         note.contains(&format!("its onset there {onset} r/min"))
@@ -432,8 +433,23 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
         "{note}"
     );
     // mu 0.35, whose onset near 5 000 r/min both presets find: confirmed, exit 0.
-    let mut ok = args.to_vec();
-    ok[3] = "0.35";
+    let ok = [
+        "critical",
+        "--json",
+        "--mu",
+        "0.35",
+        "--from",
+        "2000",
+        "--to",
+        "16000",
+        "--resolution-rpm",
+        "1000",
+        "--tol-rpm",
+        "100",
+        "--fidelity",
+        "draft",
+        "--no-progress",
+    ];
     let o = whirlmap(&ok);
     assert_eq!(o.status.code(), Some(0), "{}", out(&o));
     let rows: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
@@ -449,19 +465,22 @@ fn a_re_check_that_does_not_confirm_the_onset_exits_1() {
     );
 }
 
-/// A row without an onset bracket is re-checked at the end of the range that decides it. At
-/// mu 0.25 `draft` puts the onset near 13 400 r/min, beyond a range that ends at 12 000, while
-/// `standard` puts it near 11 500, inside: the draft row's "no whirl in the range" is not
-/// confirmed (exit 1), and `standard`'s onset, searched again below the range top, is the one
-/// a `standard` search of the range finds. At mu 0.1 (no whirl at either preset) the range
-/// top confirms it; at mu 0.4 (whirl from 6000 r/min at both) the range bottom does.
+/// A row without an onset bracket is re-checked at the end of the range that decides it: at
+/// mu 0.1 (no whirl at either preset) the range top confirms it; at mu 0.4 (whirl from
+/// 6000 r/min at both) the range bottom does, and the search exits 0. Such a row that the
+/// re-check does not confirm is searched again near its deciding end
+/// (`a_row_without_a_bracket_is_re_checked_at_its_deciding_end` in the sweep crate's
+/// `recheck.rs`) and says so in the table (`the_onset_line_says_what_the_re_check_found`):
+/// `draft` and `standard` agree too closely on the paper's scene to give one here (their
+/// onsets differ by 62.5 r/min at most over the main job's search, each `draft` onset at
+/// or below `standard`'s).
 #[test]
 fn a_row_without_a_bracket_is_re_checked_at_the_end_that_decides_it() {
     let args = [
         "critical",
         "--json",
         "--mu",
-        "0.1,0.25,0.4",
+        "0.1,0.4",
         "--from",
         "6000",
         "--to",
@@ -475,9 +494,9 @@ fn a_row_without_a_bracket_is_re_checked_at_the_end_that_decides_it() {
         "draft",
     ];
     let o = whirlmap(&args);
-    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
+    assert_eq!(o.status.code(), Some(0), "{}", out(&o));
     let rows: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
-    for r in 0..3 {
+    for r in 0..2 {
         assert!(rows[r]["bracket_rpm"].is_null(), "{rows}");
     }
     // mu 0.1: no whirl, confirmed at the range top.
@@ -490,48 +509,15 @@ fn a_row_without_a_bracket_is_re_checked_at_the_end_that_decides_it() {
     assert!(rc.get("hi").is_none() && rc["confirmed"] == true, "{rc}");
     assert_eq!(rows[0]["converged"], true, "{rows}");
     // mu 0.4: whirl from the lowest speed, confirmed there.
-    let rc = &rows[2]["recheck"];
+    let rc = &rows[1]["recheck"];
     assert_eq!(rc["hi"][0], 6000.0, "{rc}");
     assert!(rc.get("lo").is_none() && rc["confirmed"] == true, "{rc}");
-    // mu 0.25: draft finds no whirl; standard whirls at the range top.
-    let row = &rows[1];
-    assert!(row["onset_rpm"].is_null(), "{row}");
-    assert_eq!(row["recheck"]["lo"][0], 12000.0, "{row}");
-    assert_eq!(row["recheck"]["confirmed"], false, "{row}");
-    assert_eq!(row["converged"], false, "{row}");
-    let note = row["note"].as_str().expect("a note");
-    assert!(
-        note.starts_with("NOT CONFIRMED by the re-check at standard: 12000 r/min backward_whirl"),
-        "{note}"
-    );
-    assert!(
-        stderr(&o).contains("does not confirm the onset at mu 0.25 (at standard:"),
-        "{}",
-        stderr(&o)
-    );
-    let mut standard = args.to_vec();
-    standard.truncate(args.len() - 2);
-    standard[3] = "0.25";
-    let o = whirlmap(&standard);
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let full: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the rows");
-    let onset = full[0]["onset_rpm"].as_f64().expect("an onset at standard");
-    assert!((6000.0..12000.0).contains(&onset), "{onset}");
-    assert_eq!(
-        row["recheck"]["relocated"]["onset_rpm"].as_f64(),
-        Some(onset),
-        "{row}"
-    );
-    assert!(note.contains("where the search found no whirl"), "{note}");
-    // The table says it in the row's headline too.
+    // The table gives both rows without a warning.
     let table: Vec<&str> = args.iter().copied().filter(|a| *a != "--json").collect();
     let o = whirlmap(&table);
-    assert_eq!(o.status.code(), Some(1), "{}", out(&o));
-    assert!(
-        out(&o).contains("none in the range, NOT CONFIRMED by the re-check"),
-        "{}",
-        out(&o)
-    );
+    assert_eq!(o.status.code(), Some(0), "{}", out(&o));
+    assert!(out(&o).contains("none in the range\n"), "{}", out(&o));
+    assert!(!out(&o).contains("CONFIRMED"), "{}", out(&o));
 }
 
 #[test]

@@ -691,12 +691,13 @@ fn a_resumed_sweep_keeps_the_finished_critical_search_and_orbits() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// A `draft` sweep whose critical search re-checks its brackets at `standard`: the bracket of
-/// mu 0.25 is not confirmed there, that of mu 0.35 is (tests/critical.rs).
+/// A `draft` sweep whose critical search re-checks its onsets at `standard`: the bracket of
+/// mu 0.25 is not confirmed there (tests/critical.rs); mu 0.35, which whirls from the range
+/// bottom at both presets, is.
 const RECHECK_SPEC: &str = r#"{"name": "rc", "duration_s": 1.0, "fidelity": "draft",
     "axes": {"speed_rpm": [4000], "mu": [0.3]},
-    "critical": {"mu": [0.25, 0.35], "speed_rpm": {"from": 2000, "to": 16000},
-      "resolution_rpm": 1000, "tol_rpm": 100, "recheck": true},
+    "critical": {"mu": [0.25, 0.35], "speed_rpm": {"from": 10000, "to": 13000},
+      "resolution_rpm": 250, "tol_rpm": 25, "recheck": true},
     "charts": ["critical"]}"#;
 
 /// With `critical.recheck`, a sweep re-checks each onset bracket at the next tighter preset
@@ -736,13 +737,13 @@ fn a_sweep_rechecks_its_critical_brackets_when_asked() {
         "--mu",
         "0.35",
         "--from",
-        "2000",
+        "10000",
         "--to",
-        "16000",
+        "13000",
         "--resolution-rpm",
-        "1000",
+        "250",
         "--tol-rpm",
-        "100",
+        "25",
         "--fidelity",
         "draft",
         "--no-progress",
@@ -938,8 +939,8 @@ fn a_resumed_critical_search_uses_exactly_the_logged_drops_of_its_scenes() {
 /// the main job's critical search at `draft`, re-checked at `standard`. Every onset the
 /// re-check confirms or finds in its window is the committed main job's (`results/paper`, a
 /// `standard` search of the whole range), to the bit. The onsets `standard` finds again within
-/// the search's 25 r/min tolerance hold (μ 0.4 and 0.45), and the sweep exits 1 for the one
-/// that does not (μ 0.25, 17 % high at `draft`).
+/// the search's 25 r/min tolerance hold (μ 0.45 and 0.5), and the sweep exits 1 for the one
+/// that does not (μ 0.25, 62.5 r/min low at `draft`, more than the tolerance).
 #[test]
 fn a_draft_search_rechecked_at_standard_finds_the_main_job_s_onsets() {
     let dir = temp_dir("draft-checked");
@@ -972,15 +973,15 @@ fn a_draft_search_rechecked_at_standard_finds_the_main_job_s_onsets() {
         confirmed >= 1 && found >= 1,
         "{confirmed} confirmed, {found} found"
     );
-    // mu 0.25, where `draft` is 17 % high: not confirmed, and found in a widened window.
+    // mu 0.25, where `draft` is 62.5 r/min low: not confirmed, and found in the window.
     let r = rows.iter().find(|r| r["mu"] == 0.25).unwrap();
     assert_eq!(r["recheck"]["confirmed"], false, "{r}");
     assert!(r["recheck"]["relocated"]["onset_rpm"].is_f64(), "{r}");
     assert_eq!(r["converged"], false, "{r}");
     assert_eq!(found, 3, "{rows:?}");
-    // mu 0.4 and 0.45: a bracket end has another class at `standard`, but its onset is
+    // mu 0.45 and 0.5: a bracket end has another class at `standard`, but its onset is
     // within the tolerance of `draft`'s, so the onset holds.
-    for mu in [0.4, 0.45] {
+    for mu in [0.45, 0.5] {
         let r = rows.iter().find(|r| r["mu"] == mu).unwrap();
         let rc = &r["recheck"];
         assert_eq!(
@@ -1001,7 +1002,7 @@ fn a_draft_search_rechecked_at_standard_finds_the_main_job_s_onsets() {
     }
     let err = stderr(&o);
     assert!(
-        err.contains("mu 0.25") && !err.contains("mu 0.4") && !err.contains("mu 0.45"),
+        err.contains("mu 0.25") && !err.contains("mu 0.45") && !err.contains("mu 0.5"),
         "{err}"
     );
     std::fs::remove_dir_all(&dir).unwrap();

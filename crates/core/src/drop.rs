@@ -47,7 +47,8 @@ use std::ops::ControlFlow;
 ///   DOPRI5 at rtol 3e-5 on the main job's grid, for 0.69 of its CPU time.
 /// - 5: the `standard` numerics are DOPRI5 at rtol 3e-5: ROS34PW2 with the race tolerance
 ///   x1000 missed the accuracy budget by up to 12 % in the maximum force of bouncing
-///   sequences and is now the `draft` preset.
+///   sequences and became the `draft` preset (until RODAS4 with the same tolerances
+///   replaced it, docs/accuracy.md#why-draft-is-rodas4).
 /// - 4: the `standard` numerics (ROS34PW2, gap bound, race tolerance x1000, rtol 1e-4) are
 ///   the scene's default solver settings, every solver setting is in the scene's JSON, and
 ///   whirl turn times are interpolated between the angle's samples.
@@ -187,8 +188,9 @@ fn check_physical(sys: &DropSystem, y: &[f64; N], t: f64) -> Result<(), SolveErr
 /// than [`AUDIT_THRESHOLD`] of its initial energy (or of the drop energy m g s, if larger)
 /// has had friction make energy, which the audit cannot see: it checks that the books
 /// balance, and they do. A safety net for gross failures, not an accuracy check (a sticking
-/// contact's drift gives heat dips below 1e-6 J in the physics tests at `standard`; `draft`
-/// drops without spin released off centre reach -40 % of m g s and pass): a wrong mode switch
+/// contact's drift gives heat dips below 1e-6 J in the physics tests at `standard`; the
+/// former `draft`, ROS34PW2, let drops without spin released off centre reach -40 % of m g s,
+/// which passed): a wrong mode switch
 /// that left a slip pushing along its own slip velocity made -1788 J of "friction heat" in a
 /// drop without spin, whose only energy was the fall's 8.5 mJ, and the audit passed
 /// (docs/model.md#guards-that-reach-zero-at-a-switch).
@@ -214,19 +216,19 @@ fn check_friction_heat(energy: &EnergyAudit, drop_energy_j: f64, t: f64) -> Resu
 /// Measured with `cargo run --release --example audit_residuals` (the full extremes matrix
 /// and drops without spin, where the only energy is the fall's m g s and the relative
 /// residual is largest). The residual of a sound drop is integration error and grows with
-/// the tolerance. Model version 8 (`--quick`: the reduced matrix of the CI test): at most
+/// the tolerance. Model version 11 (`--quick`: the reduced matrix of the CI test): at most
 /// 2.1e-5 at the scenes' own tolerances (the default RODAS4 at rtol 3e-5 with the race's
 /// velocity tolerance from the contact force; version 6 gave 8.5e-6, version 5's DOPRI5
-/// 2.9e-4), 7.1e-4 at rtol 1e-3, 0.12 at rtol 1e-2, the loosest a scene allows; 4.3e-3 with
-/// the `draft` preset and 0.20 with it at no spin and no damping (30 ms).
+/// 2.9e-4), 7.1e-4 at rtol 1e-3, 8.3e-2 at rtol 1e-2, the loosest a scene allows; 3.0e-4 with
+/// the `draft` preset and 3.1e-2 with it at no spin and no damping (30 ms).
 /// Drops whose books are broken, with energy created (negative losses, e.g. the race's
 /// absolute tolerance loosened 1e4-fold under the explicit DOPRI5 stepper at no spin),
 /// measured 1.0 to 1.7, as did a rotor inertia of 1e-300 kg m^2 that validation now
-/// refuses. 0.5 lies between the two. An undamped drop without spin at the `draft` preset
-/// crosses it over a full second: the L-stable stepper damps the undamped contact
-/// oscillations numerically and loses 0.91 of the fall's energy, so that drop fails, rightly,
-/// since its numbers are not to be trusted; version 5's default numerics closed the same drop
-/// to 2.8e-2 (docs/accuracy.md#energy-audit).
+/// refuses. 0.5 lies between the two. An undamped drop without spin over a full second closes
+/// to 3.6e-3 at the `draft` preset; the former `draft` (ROS34PW2 with the race's tolerances
+/// widened) crossed the threshold there, damping the undamped contact oscillations
+/// numerically and losing 0.88-0.91 of the fall's energy, so that drop failed, rightly, since
+/// its numbers were not to be trusted (docs/accuracy.md#energy-audit).
 pub const AUDIT_THRESHOLD: f64 = 0.5;
 
 impl EnergyAudit {

@@ -1,6 +1,6 @@
 //! Fidelity presets: named trade-offs between speed and accuracy, chosen from the measured
-//! work-precision study of `whirlmap accuracy` (`results/accuracy/`,
-//! docs/accuracy.md#fidelity-presets).
+//! work-precision studies of `whirlmap accuracy` (`results/accuracy/`,
+//! `results/accuracy-draft/`, docs/accuracy.md#fidelity-presets).
 //!
 //! A preset sets only numerics: the tolerance, the integrator, the free-flight gap bound and
 //! the race's tolerance scale (and the full model: it switches the quasi-static race off). It
@@ -16,10 +16,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
-    /// Screening: ROS34PW2 (linearly implicit, L-stable) with the free-flight gap bound and
-    /// the race's absolute tolerances x1000, at rtol 1e-4. Cheaper than `standard`, but
+    /// Screening: RODAS4 (as `standard`) with the free-flight gap bound and the race's
+    /// absolute tolerances x1000, at rtol 1e-4: the most accurate setting at its cost in the
+    /// `draft` study (`results/accuracy-draft/`). About half of `standard`'s time, but
     /// outside the accuracy budget: on bouncing sequences its maximum force is off by up to
-    /// 12 % (docs/accuracy.md#fidelity-presets).
+    /// 0.23 % (docs/accuracy.md#fidelity-presets).
     Draft,
     /// Design work, and the scene default: RODAS4 on the full Jacobian at rtol 3e-5, with the
     /// free-flight gap bound and the race's velocity tolerance widened from the contact force
@@ -65,7 +66,7 @@ impl Fidelity {
         match self {
             Fidelity::Draft => SolverSettings {
                 rtol: 1e-4,
-                method: Method::Ros34pw2,
+                method: Method::Rodas4,
                 free_flight_gap_bound: true,
                 race_atol_scale: 1000.0,
                 race_velocity_atol_from_force: false,

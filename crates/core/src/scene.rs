@@ -40,11 +40,13 @@ pub enum Method {
     Dop853,
     /// ROS34PW2, a linearly implicit Rosenbrock-W method of order 3 (Rang and Angermann
     /// 2005) with an analytic stiff Jacobian: its step is not bounded by the light race's
-    /// contact mode (`ode/rosw.rs`). The `draft` fidelity's.
+    /// contact mode (`ode/rosw.rs`). Was the `draft` fidelity's, until RODAS4 at the same
+    /// tolerances measured closer to `reference` at the same cost
+    /// (docs/accuracy.md#fidelity-presets).
     Ros34pw2,
     /// RODAS4, a Rosenbrock method of order 4 (Hairer and Wanner) on the full Jacobian and
     /// the factors of ROS34PW2 (`ode/rodas.rs`): the `standard` fidelity's (the scene
-    /// default).
+    /// default), and the `draft` fidelity's at rtol 1e-4.
     #[default]
     Rodas4,
     /// Rodas5P, a Rosenbrock method of order 5 (Steinebach 2023) on the full Jacobian and
@@ -109,8 +111,8 @@ pub struct SolverSettings {
     pub max_events: u64,
     /// The integrator. Default `rodas4`, the 4th-order Rosenbrock method on the model's full
     /// Jacobian, whose step is not bounded by the light race's contact modes (the `standard`
-    /// fidelity's); `dopri5`, the explicit Dormand-Prince 5(4) pair (the `reference`
-    /// fidelity's); `ros34pw2`, the 3rd-order Rosenbrock-W method (the `draft` fidelity's);
+    /// and `draft` fidelities'); `dopri5`, the explicit Dormand-Prince 5(4) pair (the
+    /// `reference` fidelity's); `ros34pw2`, the 3rd-order Rosenbrock-W method;
     /// `dop853` the independent reference of `whirlmap accuracy`; `rodas5p`, the 5th-order
     /// Rosenbrock method on RODAS4's Jacobian, for errors below about 1e-5 (docs/accuracy.md);
     /// `radau5`, the 5th-order Radau IIA collocation method on the same Jacobian, about half
@@ -124,7 +126,7 @@ pub struct SolverSettings {
     /// Factor on the absolute tolerances of the race's translation (its centre's position
     /// and velocity). The race centre is a fast variable held by two stiff springs (its own
     /// modes at 3-16 kHz): with its support damped in every direction
-    /// (`support_damper = isotropic`, the default) and an L-stable stepper (`ros34pw2`) its
+    /// (`support_damper = isotropic`, the default) and an L-stable stepper (`rodas4`) its
     /// local errors decay instead of accumulating, and the rotor's absolute tolerances
     /// (`rtol * position_scale_m` on positions, `rtol * sqrt(2 g s) / 100` on velocities)
     /// would bound the implicit step in contact. Default 1 (the `standard` and `reference`

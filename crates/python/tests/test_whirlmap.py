@@ -212,11 +212,11 @@ def test_critical_warns_when_unsettled_drops_leave_the_onset_undecided() -> None
 
 
 def test_an_onset_the_re_check_finds_again_within_the_tolerance_holds() -> None:
-    # At mu 0.4 standard gives another class at draft's bracket end, 4390.625 r/min, but
-    # puts the onset at 4375 r/min, within the 25 r/min tolerance: no warning.
+    # At mu 0.45 standard gives another class at draft's bracket end, 3781.25 r/min, but
+    # puts the onset at 3796.875 r/min, within the 25 r/min tolerance: no warning.
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
-        rows = whirlmap.critical(0.4, from_rpm=1000, to_rpm=5000, fidelity="draft")
+        rows = whirlmap.critical(0.45, from_rpm=1000, to_rpm=5000, fidelity="draft")
     rc = rows[0]["recheck"]
     assert rc["confirmed"] is False and rc["within_tol"] is True
     assert abs(rc["relocated"]["onset_rpm"] - rows[0]["onset_rpm"]) <= 25.0
@@ -225,10 +225,11 @@ def test_an_onset_the_re_check_finds_again_within_the_tolerance_holds() -> None:
 
 
 def test_critical_warns_when_the_re_check_does_not_confirm_the_onset() -> None:
-    # At mu 0.25 the draft preset's bracket lies where standard whirls on both sides.
+    # At mu 0.25 the draft preset's bracket lies where standard gives pendulum on both
+    # sides, 62.5 r/min below standard's onset (the tolerance is 25 r/min).
     with pytest.warns(RuntimeWarning, match="does not confirm the onset at mu 0.25"):
         rows = whirlmap.critical(
-            0.25, from_rpm=2000, to_rpm=16000, resolution_rpm=1000, tol_rpm=100,
+            0.25, from_rpm=10000, to_rpm=13000, resolution_rpm=250, tol_rpm=25,
             fidelity="draft",
         )  # fmt: skip
     assert rows[0]["recheck"]["confirmed"] is False
@@ -238,9 +239,9 @@ def test_critical_warns_when_the_re_check_does_not_confirm_the_onset() -> None:
     # run here whole, finds the same.
     relocated = rows[0]["recheck"]["relocated"]
     whole = whirlmap.critical(
-        0.25, from_rpm=2000, to_rpm=16000, resolution_rpm=1000, tol_rpm=100,
+        0.25, from_rpm=10000, to_rpm=13000, resolution_rpm=250, tol_rpm=25,
     )  # fmt: skip
-    assert relocated["onset_rpm"] == whole[0]["onset_rpm"] < rows[0]["bracket_rpm"][0]
+    assert relocated["onset_rpm"] == whole[0]["onset_rpm"] > rows[0]["bracket_rpm"][1]
     assert relocated["note"] in rows[0]["note"]
 
 
