@@ -457,10 +457,35 @@ mod tests {
             onset_line(&row(within_tol)),
             "11406.2 r/min (bracket 11390.6-11406.2)"
         );
+        let not_converged = |v: &mut serde_json::Value| {
+            bracket(v);
+            v["recheck"]["confirmed"] = true.into();
+        };
+        assert_eq!(
+            onset_line(&row(not_converged)),
+            "11406.2 r/min (bracket 11390.6-11406.2, NOT converged)"
+        );
         let undecided = |v: &mut serde_json::Value| {
             v["undecided"] = true.into();
             v["converged"] = false.into();
         };
         assert_eq!(onset_line(&row(undecided)), "UNDECIDED (failed drops)");
+        // Failed drops below an onset come before what the re-check says.
+        let undecided_bracket = |v: &mut serde_json::Value| {
+            bracket(v);
+            undecided(v);
+        };
+        assert_eq!(
+            onset_line(&row(undecided_bracket)),
+            "11406.2 r/min (bracket 11390.6-11406.2, UNDECIDED: failed drops below it)"
+        );
+        let undecided_bottom = |v: &mut serde_json::Value| {
+            whirl_from_bottom(v);
+            undecided(v);
+        };
+        assert_eq!(
+            onset_line(&row(undecided_bottom)),
+            "at or below 1000 r/min (whirl at the lowest speed; UNDECIDED: failed drops below it)"
+        );
     }
 }

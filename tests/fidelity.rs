@@ -28,13 +28,13 @@ fn draft_is_cheaper_and_close_on_the_first_impact_and_a_bad_preset_exits_2() {
         evals(&draft),
         evals(&standard)
     );
-    // The first impact agrees within the draft's accuracy (0.2 % in the work-precision study)
-    // and the reference agrees with the standard within its budget (0.1 %).
+    // The first impact agrees within the accuracy budget (0.1 %) at both presets: `draft`'s
+    // worst first-impact error over the work-precision study's cases is 4.5e-5.
     let reference = record(&[&base[..], &["--fidelity", "reference"]].concat());
     let f = |v: &serde_json::Value| v["first_contact_force_n"].as_f64().unwrap();
     let rel = |a: &serde_json::Value| ((f(a) - f(&reference)) / f(&reference)).abs();
     assert!(
-        rel(&draft) < 2e-3,
+        rel(&draft) < 1e-3,
         "draft first impact off by {}",
         rel(&draft)
     );

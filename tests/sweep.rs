@@ -700,7 +700,7 @@ const RECHECK_SPEC: &str = r#"{"name": "rc", "duration_s": 1.0, "fidelity": "dra
       "resolution_rpm": 250, "tol_rpm": 25, "recheck": true},
     "charts": ["critical"]}"#;
 
-/// With `critical.recheck`, a sweep re-checks each onset bracket at the next tighter preset
+/// With `critical.recheck`, a sweep re-checks each row at the next tighter preset
 /// as `whirlmap critical --fidelity` does: its rows are the command's, a bracket the tighter
 /// preset does not confirm (mu 0.25 at `draft`, see tests/critical.rs) leaves its row not
 /// converged, the summary and standard error name it, and the sweep exits 1.
@@ -952,27 +952,28 @@ fn a_draft_search_rechecked_at_standard_finds_the_main_job_s_onsets() {
         read_json(&Path::new(env!("CARGO_MANIFEST_DIR")).join("results/paper/critical.json"));
     let (rows, main) = (rows.as_array().unwrap(), main.as_array().unwrap());
     assert_eq!(rows.len(), main.len());
-    let (mut confirmed, mut found) = (0, 0);
+    // Every row is re-checked: a bracket at its two ends, a row without one (no whirl in the
+    // range, in both) at the range top.
+    let (mut confirmed_brackets, mut confirmed_no_whirl, mut found) = (0, 0, 0);
     for (r, m) in rows.iter().zip(main) {
         assert_eq!(r["mu"], m["mu"]);
-        let Some(rc) = r.get("recheck") else {
-            // No bracket: no whirl in the range, in both.
-            let null = serde_json::Value::Null;
-            assert_eq!((&r["onset_rpm"], &m["onset_rpm"]), (&null, &null), "{r}");
-            continue;
-        };
+        let rc = &r["recheck"];
+        assert_eq!(rc["fidelity"], "standard", "{r}");
         if rc["confirmed"] == true {
-            confirmed += 1;
             assert_eq!(r["onset_rpm"], m["onset_rpm"], "{r}");
+            if r["bracket_rpm"].is_null() {
+                assert!(r["onset_rpm"].is_null(), "{r}");
+                confirmed_no_whirl += 1;
+            } else {
+                confirmed_brackets += 1;
+            }
         } else if let Some(onset) = rc["relocated"]["onset_rpm"].as_f64() {
             found += 1;
             assert_eq!(Some(onset), m["onset_rpm"].as_f64(), "{r}");
         }
     }
-    assert!(
-        confirmed >= 1 && found >= 1,
-        "{confirmed} confirmed, {found} found"
-    );
+    // mu 0.05-0.2 and 0.3 (no whirl); mu 0.35 and 0.4 (brackets).
+    assert_eq!((confirmed_no_whirl, confirmed_brackets), (5, 2), "{rows:?}");
     // mu 0.25, where `draft` is 62.5 r/min low: not confirmed, and found in the window.
     let r = rows.iter().find(|r| r["mu"] == 0.25).unwrap();
     assert_eq!(r["recheck"]["confirmed"], false, "{r}");

@@ -189,8 +189,8 @@ fn check_physical(sys: &DropSystem, y: &[f64; N], t: f64) -> Result<(), SolveErr
 /// has had friction make energy, which the audit cannot see: it checks that the books
 /// balance, and they do. A safety net for gross failures, not an accuracy check (a sticking
 /// contact's drift gives heat dips below 1e-6 J in the physics tests at `standard`; the
-/// former `draft`, ROS34PW2, let drops without spin released off centre reach -40 % of m g s,
-/// which passed): a wrong mode switch
+/// former `draft`, ROS34PW2, let drops without spin released off centre dip to about -40 % of
+/// m g s, which passed): a wrong mode switch
 /// that left a slip pushing along its own slip velocity made -1788 J of "friction heat" in a
 /// drop without spin, whose only energy was the fall's 8.5 mJ, and the audit passed
 /// (docs/model.md#guards-that-reach-zero-at-a-switch).

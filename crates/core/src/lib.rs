@@ -28,9 +28,9 @@
 //!   with `thermal`; without it nothing thermal is computed.
 //!
 //! ## Integrator
-//! [`ode`]: the linearly implicit Rosenbrock-W method ROS34PW2 with an analytic stiff
-//! Jacobian by default (the `standard` fidelity), Dormand-Prince 5(4) (the `reference`
-//! fidelity) and DOP853, all with dense output; contact onset and loss, support release, slip
+//! [`ode`]: the Rosenbrock method RODAS4 on the model's full Jacobian by default (the
+//! `standard` and `draft` fidelities), the Rosenbrock-W method ROS34PW2, Rodas5P, RADAU5,
+//! Dormand-Prince 5(4) (the `reference` fidelity) and DOP853, all with dense output; contact onset and loss, support release, slip
 //! reversal and stick break-away are guard crossings located on the interpolant; the step is
 //! bounded in free flight; force and power peaks are located on the interpolant by the
 //! [`monitor::Monitor`] observer. Errors are typed and carry the time ([`SolveError`]).

@@ -53,7 +53,8 @@ const BHAT: [f64; 4] = [
 /// `S v = r_v + hg J_vq r_q` (10 components with 4 positions: a 6x6 factor, 4x fewer
 /// operations than the 10x10 one). The model's 6x6 complement is factored in place in
 /// nalgebra's fixed-size storage by a hand-written kernel ([`lu6`]): nalgebra's generic LU
-/// costs 3 % more instructions on the standard 1 s drop (94.4 M against 91.7 M, callgrind).
+/// costs 3 % more instructions on the 1 s drop at the ROS34PW2 setting of the time (94.4 M against
+/// 91.7 M, callgrind).
 /// Other shapes (the stepper's tests) use nalgebra's LU in dynamic storage.
 #[derive(Debug, Clone)]
 pub(super) struct Lu {
@@ -515,8 +516,8 @@ impl<const N: usize> Stepper<N> for Ros34pw2<N> {
             law: &LAW,
             gamma: GAMMA,
             attempt: Self::attempt::<S>,
-            // Measured with them on 2026-11-24: the drops at `draft`, then ROS34PW2, took 0.1-0.5 % more RHS
-            // evaluations, so the W-method keeps its matrix without them.
+            // Measured with them on 2026-11-24: the drops at `draft`, then ROS34PW2, took
+            // 0.1-0.5 % more RHS evaluations, so the W-method keeps its matrix without them.
             quadratures: false,
             own_dense: false,
         };
