@@ -10,7 +10,7 @@ use whirlmap_sweep::critical::{check_mus, CriticalOptions};
 use whirlmap_sweep::shard::MAX_SHARDS;
 
 /// A clap value parser: a finite or infinite number (`1e3`, `-0.5`; `-0` reads as 0, so it
-/// is echoed and hashed as 0), else "not a number; allowed <range>" with the range `allowed`
+/// is echoed and hashed as 0), else "not a number; allowed `<range>`" with the range `allowed`
 /// states.
 pub(crate) fn number(
     allowed: fn() -> String,

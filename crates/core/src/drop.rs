@@ -54,7 +54,7 @@ use std::ops::ControlFlow;
 ///   whirl turn times are interpolated between the angle's samples.
 /// - 3: the isotropic support damper is the default ([`crate::scene::SupportDamper`]);
 ///   classes describe the settled motion on a final window, undecided runs are extended,
-///   and the whirl rule counts consecutive carried turns ([`crate::classify`]).
+///   and the whirl rule counts consecutive carried turns ([`crate::classify`](mod@crate::classify)).
 /// - 2: a slip entered against the drifted slip velocity takes its sign.
 pub const MODEL_VERSION: u32 = 11;
 
@@ -339,7 +339,7 @@ pub struct DropReport {
     /// Ball loads, contact pressure and fatigue of the touchdown bearing, when the scene
     /// asks for the bearing analysis ([`crate::bearing`]).
     pub bearing: Option<BearingReport>,
-    /// The orbit class, whether it settled, and why ([`crate::classify`]).
+    /// The orbit class, whether it settled, and why ([`crate::classify`](mod@crate::classify)).
     pub verdict: Verdict,
     /// How far the run was extended past its duration to let the class settle (s); 0 when
     /// it settled (or stopped) by then.

@@ -36,7 +36,7 @@
 //! [`monitor::Monitor`] observer. Errors are typed and carry the time ([`SolveError`]).
 //!
 //! ## Classification
-//! [`classify`]: the orbit class is decided on the final window of the run from streamed
+//! [`classify`](mod@classify): the orbit class is decided on the final window of the run from streamed
 //! features; a run that has not settled is extended until it has (up to a cap).
 //!
 //! ## One drop

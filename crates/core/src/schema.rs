@@ -1,7 +1,7 @@
 //! What a scene accepts, field by field: the allowed range of every numeric field
-//! ([`FIELD_RANGES`], checked against [`Scene::validate`] by a test, so the two cannot drift),
+//! ([`FIELD_RANGES`], checked against [`Scene::validate`](crate::Scene::validate) by a test, so the two cannot drift),
 //! the unit read from the field's name ([`unit_of`]), and, with the `schema` feature, the
-//! scene's JSON Schema ([`scene_schema`]): the structure, types, defaults and descriptions
+//! scene's JSON Schema (`scene_schema`): the structure, types, defaults and descriptions
 //! derived from the Rust types and their doc comments, with the ranges, units and sources
 //! added per field.
 
@@ -19,7 +19,7 @@ pub enum Bound {
 
 /// The allowed range of one numeric scene field, by dotted key. A side that depends on
 /// another field (`unbalance_m <= 10 clearance_m`) is `None` here and stated in the field's
-/// doc comment; [`Scene::validate`] checks it.
+/// doc comment; [`Scene::validate`](crate::Scene::validate) checks it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FieldRange {
     /// Dotted key, as `--set` takes it.
@@ -36,7 +36,7 @@ const fn r(key: &'static str, min: Option<Bound>, max: Option<Bound>) -> FieldRa
 use Bound::{Exclusive as Ex, Inclusive as In};
 
 /// Allowed ranges of the scene's numeric fields (the thermal model's under `thermal.`, the
-/// bearing analysis's under `bearing.`), as [`Scene::validate`],
+/// bearing analysis's under `bearing.`), as [`Scene::validate`](crate::Scene::validate),
 /// [`crate::ThermalParams::validate`] and [`crate::bearing::BearingPair::validate_fields`]
 /// enforce them.
 pub const FIELD_RANGES: &[FieldRange] = &[
@@ -412,7 +412,7 @@ mod tests {
     }
 
     /// The per-field checks (a value at a range end may still break a consistency rule
-    /// between fields, which [`Scene::validate`] adds; the ranges are per field).
+    /// between fields, which [`Scene::validate`](crate::Scene::validate) adds; the ranges are per field).
     fn check(s: &Scene) -> Result<(), crate::InvalidParameter> {
         s.validate_fields()?;
         s.thermal.as_ref().map_or(Ok(()), ThermalParams::validate)?;

@@ -72,11 +72,11 @@ pub enum Mark {
     ArrowDown(RGBColor),
     /// An open circle.
     OpenDot(RGBColor),
-    /// An open square ([`open_square`]).
+    /// An open square (drawn by `open_square`).
     OpenSquare(RGBColor),
-    /// A filled diamond ([`diamond`]).
+    /// A filled diamond (drawn by `diamond`).
     Diamond(RGBColor),
-    /// Where a drop was, on a grid of uneven cells ([`drop_dot`]).
+    /// Where a drop was, on a grid of uneven cells (drawn by `drop_dot`).
     Drop,
 }
 

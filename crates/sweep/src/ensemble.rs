@@ -845,7 +845,7 @@ fn cells_csv(stats: &[CellStats]) -> String {
 ///
 /// The manifest is written first (`complete` false), and each member's record is appended
 /// to `members.jsonl` in (cell, member) order as soon as it and every member before it are
-/// done ([`MemberWriter`]), so a killed run keeps every record it wrote. With `resume`, the
+/// done (`MemberWriter`), so a killed run keeps every record it wrote. With `resume`, the
 /// members the folder already holds are kept and only the rest run: the folder's manifest
 /// must name the same spec, model version and whirlmap version ([`resumable_members`]); a
 /// folder with no members starts anew. The result is the same, byte for byte, as one run

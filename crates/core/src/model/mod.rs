@@ -209,7 +209,7 @@ impl OdeSystem<N> for DropSystem {
         self.with_forces(y, |f| self.guards_of(f, g))
     }
 
-    /// See [`DropSystem::stiff_jacobian_at`] (`jacobian.rs`).
+    /// See `DropSystem::stiff_jacobian_at` (`jacobian.rs`).
     fn stiff_jacobian(&self, _t: f64, y: &[f64; N]) -> Option<StiffJacobian> {
         Some(self.stiff_jacobian_at(y))
     }
