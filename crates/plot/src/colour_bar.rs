@@ -53,11 +53,13 @@ pub(crate) fn draw_colour_bar<DB: DrawingBackend>(
         .build_cartesian_2d(0.0..1.0, lo..hi)?;
     let linear = tick_formatter(hi - lo);
     let fmt: &dyn Fn(&f64) -> String = if b.log { b.tick } else { &linear };
-    // On a log scale one tick per decade (plotters picks round values of the exponent).
-    let ticks = if b.log {
-        ((hi - lo).ceil() as usize + 1).clamp(2, 10)
-    } else {
-        8
+    // On a log scale one tick per decade (plotters picks round values of the exponent);
+    // on one shorter than two decades, where that would leave one tick or none, up to six
+    // at round values of the exponent, each labelled with the figures that tell it apart.
+    let ticks = match b.log {
+        true if hi - lo < 2.0 => 6,
+        true => ((hi - lo).ceil() as usize + 1).clamp(2, 10),
+        false => 8,
     };
     bar.configure_mesh()
         .disable_mesh()

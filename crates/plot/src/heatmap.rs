@@ -179,6 +179,32 @@ impl Metric {
         let s = format!("{:.1e}", 10f64.powf(x));
         s.replace(".0e", "e")
     }
+
+    /// A colour bar tick's text, `x` on the scale's axis and `span` the bar's extent on it. On
+    /// a log scale shorter than a few decades, two significant figures can give two ticks the
+    /// same text (the bar of a 1 % wide scale holds ticks 0.05 % apart): each tick then gets
+    /// the figures that tell ticks a tenth of the span apart. Whole decades read `1eN`.
+    fn tick_label(&self, x: f64, span: f64) -> String {
+        if !self.log || (x - x.round()).abs() < 1e-9 {
+            return self.label(x);
+        }
+        // Ticks a tenth of the span apart differ by a factor 10^(span / 10), a relative
+        // difference of about ln(10) span / 10.
+        let rel = std::f64::consts::LN_10 * span.abs() / 10.0;
+        let decimals = if rel > 0.0 && rel.is_finite() {
+            (-rel.log10()).ceil().clamp(1.0, 6.0) as usize
+        } else {
+            1
+        };
+        let s = format!("{:.*e}", decimals, 10f64.powf(x));
+        // 2.50e3 reads 2.5e3 and 3.00e3 reads 3e3.
+        match s.split_once('e') {
+            Some((m, e)) if m.contains('.') => {
+                format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+            }
+            _ => s,
+        }
+    }
 }
 
 /// What the grid charts draw per cell.
@@ -611,7 +637,7 @@ impl Figure for GridFigure<'_> {
                 levels: &levels,
                 limit: limit.map(|(l, _, _)| l).filter(|l| (lo..=hi).contains(l)),
                 label: self.bar_label,
-                tick: &|x: &f64| m.label(*x),
+                tick: &|x: &f64| m.tick_label(*x, hi - lo),
                 log: m.log,
             };
             draw_colour_bar(&bar_area, &bar)?;
@@ -662,7 +688,40 @@ fn connected_pieces(ends: &[[(i32, i32); 2]]) -> Vec<Vec<usize>> {
 
 #[cfg(test)]
 mod tests {
-    use super::{colour_scale, connected_pieces, uneven, MIN_RELATIVE_SPAN};
+    use super::{colour_scale, connected_pieces, uneven, Metric, MIN_RELATIVE_SPAN};
+
+    /// On a log colour bar, ticks a tenth of the span apart read differently at every span
+    /// down to the floor (1 % of the values), where two significant figures once repeated;
+    /// whole decades read `1eN`, and a long scale keeps two figures.
+    #[test]
+    fn log_bar_ticks_a_tenth_of_the_span_apart_read_differently() {
+        let m = Metric {
+            log: true,
+            ..Metric::linear(|_| None)
+        };
+        for span in [
+            (1.0f64 + MIN_RELATIVE_SPAN).log10(),
+            0.01,
+            0.05,
+            0.3,
+            1.0,
+            4.0,
+        ] {
+            let lo = 2.944_482_5; // 880 (the first impact's newtons)
+            let labels: Vec<String> = (0..=10)
+                .map(|k| m.tick_label(lo + span * k as f64 / 10.0, span))
+                .collect();
+            for w in labels.windows(2) {
+                assert_ne!(w[0], w[1], "span {span}: {labels:?}");
+            }
+        }
+        // The old two figures repeat on the floor's span: the test above could fail.
+        let floor = (1.0f64 + MIN_RELATIVE_SPAN).log10();
+        assert_eq!(m.label(2.9444825), m.label(2.9444825 + floor / 10.0));
+        assert_eq!(m.tick_label(3.0, floor), "1e3");
+        assert_eq!(m.tick_label(3.0 + 2.5f64.log10(), 4.0), "2.5e3");
+        assert_eq!(m.tick_label(2.9444825, floor), "8.8e2");
+    }
 
     /// Values closer than the floor get a scale of the floor's span centred on them; values
     /// further apart keep their own range; all zero, -1 to 1; on a log scale the floor is a
