@@ -54,7 +54,8 @@ use std::ops::ControlFlow;
 ///   whirl turn times are interpolated between the angle's samples.
 /// - 3: the isotropic support damper is the default ([`crate::scene::SupportDamper`]);
 ///   classes describe the settled motion on a final window, undecided runs are extended,
-///   and the whirl rule counts consecutive carried turns ([`crate::classify`](mod@crate::classify)).
+///   and the whirl rule counts consecutive carried turns
+///   ([`crate::classify`](mod@crate::classify)).
 /// - 2: a slip entered against the drifted slip velocity takes its sign.
 pub const MODEL_VERSION: u32 = 11;
 

@@ -30,14 +30,16 @@
 //! ## Integrator
 //! [`ode`]: the Rosenbrock method RODAS4 on the model's full Jacobian by default (the
 //! `standard` and `draft` fidelities), the Rosenbrock-W method ROS34PW2, Rodas5P, RADAU5,
-//! Dormand-Prince 5(4) (the `reference` fidelity) and DOP853, all with dense output; contact onset and loss, support release, slip
-//! reversal and stick break-away are guard crossings located on the interpolant; the step is
-//! bounded in free flight; force and power peaks are located on the interpolant by the
-//! [`monitor::Monitor`] observer. Errors are typed and carry the time ([`SolveError`]).
+//! Dormand-Prince 5(4) (the `reference` fidelity) and DOP853, all with dense output; contact
+//! onset and loss, support release, slip reversal and stick break-away are guard crossings
+//! located on the interpolant; the step is bounded in free flight; force and power peaks are
+//! located on the interpolant by the [`monitor::Monitor`] observer. Errors are typed and
+//! carry the time ([`SolveError`]).
 //!
 //! ## Classification
-//! [`classify`](mod@classify): the orbit class is decided on the final window of the run from streamed
-//! features; a run that has not settled is extended until it has (up to a cap).
+//! [`classify`](mod@classify): the orbit class is decided on the final window of the run
+//! from streamed features; a run that has not settled is extended until it has (up to a
+//! cap).
 //!
 //! ## One drop
 //! ```

@@ -93,7 +93,8 @@ pub struct Window {
     pub stats: WindowStats,
 }
 
-/// What a drop measured, streamed; the classifier ([`crate::classify`](mod@crate::classify)) reads only this.
+/// What a drop measured, streamed; the classifier ([`crate::classify`](mod@crate::classify))
+/// reads only this.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Features {
     /// Peak normal force of the first impact after free fall (N); impact episodes closer

@@ -1,5 +1,6 @@
 //! What a scene accepts, field by field: the allowed range of every numeric field
-//! ([`FIELD_RANGES`], checked against [`Scene::validate`](crate::Scene::validate) by a test, so the two cannot drift),
+//! ([`FIELD_RANGES`], checked against [`Scene::validate`](crate::Scene::validate) by a test,
+//! so the two cannot drift),
 //! the unit read from the field's name ([`unit_of`]), and, with the `schema` feature, the
 //! scene's JSON Schema (`scene_schema`): the structure, types, defaults and descriptions
 //! derived from the Rust types and their doc comments, with the ranges, units and sources
@@ -412,7 +413,8 @@ mod tests {
     }
 
     /// The per-field checks (a value at a range end may still break a consistency rule
-    /// between fields, which [`Scene::validate`](crate::Scene::validate) adds; the ranges are per field).
+    /// between fields, which [`Scene::validate`](crate::Scene::validate) adds; the ranges are
+    /// per field).
     fn check(s: &Scene) -> Result<(), crate::InvalidParameter> {
         s.validate_fields()?;
         s.thermal.as_ref().map_or(Ok(()), ThermalParams::validate)?;

@@ -15,7 +15,8 @@ pub struct DropRecord {
     /// absent only in records made before the records carried their inputs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inputs: Option<DropInputs>,
-    /// Orbit class: the motion the rotor settled into ([`whirlmap_core::classify`](mod@whirlmap_core::classify)).
+    /// Orbit class: the motion the rotor settled into
+    /// ([`whirlmap_core::classify`](mod@whirlmap_core::classify)).
     pub class: OrbitClass,
     /// Why it got that class; for `unresolved`, why it had not settled at the cap.
     pub class_reason: Reason,
