@@ -181,8 +181,12 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             },
         },
     ];
+    let runs = match reps {
+        1 => "one run".to_string(),
+        n => format!("the fastest of {n} runs"),
+    };
     outln!(
-        "whirlmap bench: one thread, the fastest of {reps} runs after a warm-up (wall ms); \
+        "whirlmap bench: one thread, {runs} after a warm-up (wall ms); \
          ratios to the baseline (first row) and to the peer (a numba DOPRI5 of the same model, \
          {PEER_MS} ms for the baseline drop at rtol 1e-6; see the note below the table)"
     );

@@ -102,7 +102,8 @@ pub struct CriticalArgs {
     /// Fidelity preset (draft, standard, reference) for the search; the cells that decide
     /// each row (its onset bracket; without one, the end of the range that decides it: the
     /// top for "no whirl", the bottom for whirl from the start) are then re-checked at the
-    /// next tighter preset (recorded as `recheck`).
+    /// next tighter preset (recorded as `recheck`): `draft` at `standard`, `standard` at
+    /// `reference`; `reference` has none, and its search is not re-checked.
     #[arg(long)]
     fidelity: Option<whirlmap_core::Fidelity>,
     /// No progress (by default a bar on a terminal, a plain line every 5 s otherwise).
@@ -142,6 +143,7 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
     check_mus(&a.mu).map_err(flag_error)?;
     let mut base = build_scene(a.scene.as_deref(), &a.set, None, None).map_err(Failure::Input)?;
     if let Some(f) = a.fidelity {
+        crate::warn_preset_overrides(f, &a.set);
         f.apply(&mut base);
     }
     // Each mu must make a valid scene (e.g. mu_static >= mu_dynamic) before anything runs,
@@ -240,9 +242,9 @@ pub(crate) fn report_unconfirmed(rows: &[CriticalRow]) -> bool {
     };
     errln!(
         "error: the re-check at the next tighter preset does not confirm the onset at {list}; \
-         the answer at this preset is not to be trusted there: where the tighter preset puts \
-         the onset, searched at least two lattice steps either side of {cells} within the \
-         searched range, is in the row"
+         do not use this preset's onset there. The row gives the tighter preset's onset, \
+         searched again from two lattice steps below {cells} to two above it (within the \
+         range)"
     );
     true
 }
@@ -318,8 +320,8 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
                 .map(|(speed, o)| format!("{}: {}", fmt_rpm(*speed), show(o)))
                 .collect();
             outln!(
-                "    recheck ({})   {} -> {}",
-                rc.fidelity,
+                "    {:<20}{} -> {}",
+                format!("recheck ({})", rc.fidelity),
                 cells.join(", "),
                 if rc.confirmed && r.bracket_rpm.is_none() {
                     "confirmed".to_string()

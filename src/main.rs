@@ -427,6 +427,49 @@ fn settings_note(scene: &Scene) -> String {
     }
 }
 
+/// Says on standard error which `--set` values the preset `f` replaces (its
+/// [`whirlmap_core::Fidelity::KEYS`], or the whole `solver` section): the preset is applied
+/// after them, so they would otherwise vanish without a word.
+pub(crate) fn warn_preset_overrides(f: whirlmap_core::Fidelity, sets: &[String]) {
+    for s in sets {
+        let key = s.split_once('=').map_or(s.as_str(), |(k, _)| k).trim();
+        if key == "solver" || whirlmap_core::Fidelity::KEYS.contains(&key) {
+            errln!(
+                "warning: --fidelity {} sets the numerics, so --set {s} has no effect (leave \
+                 out --fidelity to choose them yourself)",
+                f.name()
+            );
+        }
+    }
+}
+
+/// The integrator settings a drop ran with, and the preset they are, if any: `rodas4, rtol
+/// 1e-4, race tolerance x1000 (the draft preset)`.
+fn numerics_line(scene: &Scene) -> String {
+    let s = &scene.solver;
+    let method = serde_json::to_value(s.method)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default();
+    let mut parts = vec![method, format!("rtol {:e}", s.rtol)];
+    if s.race_atol_scale != 1.0 {
+        parts.push(format!("race tolerance x{}", s.race_atol_scale));
+    }
+    if s.race_velocity_atol_from_force {
+        parts.push("race velocity tolerance from the contact force".to_string());
+    }
+    if scene.quasi_static_race {
+        parts.push("quasi-static race".to_string());
+    }
+    let preset = whirlmap_core::Fidelity::ALL
+        .into_iter()
+        .find(|f| *s == f.solver() && !scene.quasi_static_race);
+    match preset {
+        Some(f) => format!("{} (the {} preset)", parts.join(", "), f.name()),
+        None => parts.join(", "),
+    }
+}
+
 fn run_drop(a: &DropArgs) -> Result<(), Failure> {
     let on = Sections {
         thermal: a.thermal || a.temperatures.is_some(),
@@ -453,6 +496,7 @@ fn run_drop(a: &DropArgs) -> Result<(), Failure> {
         )));
     }
     if let Some(f) = a.fidelity {
+        warn_preset_overrides(f, &a.set);
         f.apply(&mut scene);
     }
     // Output paths are checked before the drop runs, not after.
@@ -599,6 +643,7 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
         "  work                  {} RHS evaluations, {} steps ({} rejected), {} events, {:.3} s wall",
         r.stats.rhs_evals, r.stats.steps, r.stats.rejected, r.stats.events, wall_s
     );
+    outln!("  numerics              {}", numerics_line(scene));
     if let Some(th) = &r.thermal {
         print_thermal(th, r.end_time_s);
     }

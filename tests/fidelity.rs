@@ -54,6 +54,65 @@ fn draft_is_cheaper_and_close_on_the_first_impact_and_a_bad_preset_exits_2() {
     );
 }
 
+/// A preset sets the numerics after `--set`: a `--set` of one of its keys has no effect, and
+/// standard error says so (for `drop` and for `critical`); a `--set` of anything else is
+/// kept, without a word. The text summary names the numerics a drop ran with.
+#[test]
+fn a_preset_says_which_set_values_it_replaces() {
+    let base = ["drop", "--duration-s", "0.02", "--fidelity", "draft"];
+    fn json<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        [base, extra, &["--json"]].concat()
+    }
+    let draft = record(&json(&base, &[]));
+    let out = whirlmap(&json(&base, &["--set", "solver.rtol=1e-6"]));
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(
+            "warning: --fidelity draft sets the numerics, so --set solver.rtol=1e-6 has no effect"
+        ),
+        "{err}"
+    );
+    let overridden: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(overridden, draft);
+    let out = whirlmap(&json(&base, &["--set", "unbalance_m=1e-6"]));
+    assert!(out.status.success());
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+    let kept: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_ne!(kept["scene_hash"], draft["scene_hash"]);
+    let out = whirlmap(&base);
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains(
+            "numerics              rodas4, rtol 1e-4, race tolerance x1000 (the draft preset)"
+        ),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let out = whirlmap(&[
+        "critical",
+        "--mu",
+        "0.1",
+        "--from",
+        "2000",
+        "--to",
+        "3000",
+        "--resolution-rpm",
+        "1000",
+        "--duration-s",
+        "0.05",
+        "--fidelity",
+        "draft",
+        "--set",
+        "quasi_static_race=true",
+        "--no-progress",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--set quasi_static_race=true has no effect"),
+        "{err}"
+    );
+}
+
 #[test]
 fn accuracy_writes_its_table_and_charts() {
     let dir = std::env::temp_dir().join(format!("whirlmap-acc-{}", std::process::id()));

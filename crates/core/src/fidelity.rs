@@ -84,9 +84,21 @@ impl Fidelity {
         }
     }
 
+    /// The scene keys (dotted, as `--set` takes them) that [`Fidelity::apply`] sets: a value
+    /// given for one of them before the preset is applied does not survive it.
+    pub const KEYS: [&'static str; 6] = [
+        "solver.rtol",
+        "solver.method",
+        "solver.free_flight_gap_bound",
+        "solver.race_atol_scale",
+        "solver.race_velocity_atol_from_force",
+        "quasi_static_race",
+    ];
+
     /// Sets the preset's numerics on `scene` (tolerance, integrator, gap bound, race
     /// tolerance scale, the race's velocity tolerance from the force), and the full model
-    /// (`quasi_static_race` off). The physics a user chose stays as it is.
+    /// (`quasi_static_race` off): the keys of [`Fidelity::KEYS`]. The physics a user chose
+    /// stays as it is.
     pub fn apply(self, scene: &mut Scene) {
         let p = self.solver();
         let s = &mut scene.solver;
@@ -157,5 +169,42 @@ mod tests {
         }
         assert_eq!(Fidelity::Draft.tighter(), Some(Fidelity::Standard));
         assert_eq!(Fidelity::Reference.tighter(), None);
+    }
+
+    /// `KEYS` is what `apply` sets: a preset changes no other key of a scene, and a value
+    /// given for any of its keys before it does not survive it.
+    #[test]
+    fn the_keys_are_those_a_preset_sets() {
+        let other = [
+            ("solver.rtol", serde_json::json!(1e-6)),
+            ("solver.method", serde_json::json!("dop853")),
+            ("solver.free_flight_gap_bound", serde_json::json!(false)),
+            ("solver.race_atol_scale", serde_json::json!(7.0)),
+            (
+                "solver.race_velocity_atol_from_force",
+                serde_json::json!(false),
+            ),
+            ("quasi_static_race", serde_json::json!(true)),
+        ];
+        let keys: Vec<&str> = other.iter().map(|(k, _)| *k).collect();
+        assert_eq!(keys, Fidelity::KEYS);
+        let paper = Scene::paper();
+        for f in Fidelity::ALL {
+            let preset = f.applied(&paper);
+            for k in crate::scene::scene_changes(&preset).keys() {
+                assert!(Fidelity::KEYS.contains(&k.as_str()), "{f:?} sets {k}");
+            }
+            for (key, value) in &other {
+                let mut v = serde_json::to_value(&paper).unwrap();
+                let mut at = &mut v;
+                for part in key.split('.') {
+                    at = &mut at[part];
+                }
+                *at = value.clone();
+                let given: Scene = serde_json::from_value(v).unwrap();
+                assert_ne!(given, paper, "{key}");
+                assert_eq!(f.applied(&given), preset, "{f:?} keeps {key}");
+            }
+        }
     }
 }

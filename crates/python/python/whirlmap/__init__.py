@@ -369,8 +369,8 @@ def critical(
         warnings.warn(
             "the re-check at the next tighter preset does not confirm the onset at "
             + ", ".join(unconfirmed)
-            + "; the answer at this preset is not to be trusted there (each row's"
-            + " recheck says where the tighter preset puts it)",
+            + "; do not use this preset's onset there (each row's recheck says where"
+            + " the tighter preset puts it)",
             RuntimeWarning,
             stacklevel=2,
         )
