@@ -356,8 +356,8 @@ fn sweep(
     Ok(serde_json::to_string(&records).expect("records serialise"))
 }
 
-/// The native module: `drop`, `critical`, `sweep`, `default_scene`, `SimulationError` and
-/// `MODEL_VERSION`.
+/// The native module: `drop`, `critical`, `sweep`, `default_scene`, `SimulationError`,
+/// `MODEL_VERSION` and `PRESET_KEYS` (the scene keys a fidelity preset sets).
 #[pymodule]
 fn _whirlmap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(drop_one, m)?)?;
@@ -366,5 +366,6 @@ fn _whirlmap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_scene, m)?)?;
     m.add("SimulationError", m.py().get_type::<SimulationError>())?;
     m.add("MODEL_VERSION", MODEL_VERSION)?;
+    m.add("PRESET_KEYS", Fidelity::KEYS.to_vec())?;
     Ok(())
 }

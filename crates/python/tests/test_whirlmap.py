@@ -245,6 +245,22 @@ def test_critical_warns_when_the_re_check_does_not_confirm_the_onset() -> None:
     assert relocated["note"] in rows[0]["note"]
 
 
+def test_a_preset_warns_of_the_overrides_it_replaces() -> None:
+    with pytest.warns(RuntimeWarning, match="solver__rtol=1e-06 has no effect"):
+        replaced = whirlmap.drop(duration_s=0.02, fidelity="draft", solver__rtol=1e-6, series=False)
+    draft = whirlmap.drop(duration_s=0.02, fidelity="draft", series=False)
+    assert replaced.record == draft.record
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        kept = whirlmap.drop(duration_s=0.02, fidelity="draft", unbalance_m=1e-6, series=False)
+    assert kept.record["scene_hash"] != draft.record["scene_hash"]
+    with pytest.warns(RuntimeWarning, match="quasi_static_race=True has no effect"):
+        whirlmap.critical(
+            0.1, from_rpm=2000, to_rpm=3000, resolution_rpm=1000, duration_s=0.05,
+            fidelity="draft", quasi_static_race=True,
+        )  # fmt: skip
+
+
 def test_critical_checks_before_running() -> None:
     with pytest.raises(ValueError, match="to_rpm"):
         whirlmap.critical(0.4, from_rpm=5000, to_rpm=4000)

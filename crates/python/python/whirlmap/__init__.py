@@ -164,6 +164,23 @@ def _fidelity(fidelity: Optional[str]) -> Optional[str]:
     return fidelity
 
 
+def _warn_preset_overrides(fidelity: Optional[str], overrides: Dict[str, Any]) -> None:
+    """Warns of each override a fidelity preset replaces: the preset is applied after the
+    overrides and sets the numerics (``solver__rtol``, ``solver__method``, ... and
+    ``quasi_static_race``), so they would otherwise vanish without a word."""
+    if fidelity is None:
+        return
+    for key, value in overrides.items():
+        dotted = key.replace("__", ".")
+        if dotted == "solver" or dotted in _whirlmap.PRESET_KEYS:
+            warnings.warn(
+                f"fidelity={fidelity!r} sets the numerics, so {key}={value!r} has no effect"
+                " (leave out fidelity to choose them yourself)",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+
+
 def default_scene() -> Dict[str, Any]:
     """The default (paper) scene as a dict: every key a scene override may name.
 
@@ -227,6 +244,7 @@ def drop(
         raise ValueError(
             f"invalid series_points = {series_points!r}: allowed a whole number in [1, 1e7]"
         )
+    _warn_preset_overrides(fidelity, overrides)
     record, scene, arrays, clearance_m = _whirlmap.drop(
         None if speed_rpm is None else float(speed_rpm),
         None if mu is None else float(mu),
@@ -323,6 +341,7 @@ def critical(
                 f"invalid {key} = {overrides[key]!r}: allowed no value here, {by} set it "
                 "for every drop of the search"
             )
+    _warn_preset_overrides(fidelity, overrides)
     text = _whirlmap.critical(
         mus,
         float(from_rpm),
