@@ -359,36 +359,30 @@ fn print_table(a: &CriticalArgs, rows: &[CriticalRow], wall_s: f64) {
 /// where the range already whirls, or "none in the range", each with what holds it back
 /// (failed drops, a re-check that does not confirm it, no convergence).
 fn onset_line(r: &CriticalRow) -> String {
-    let not_confirmed = r.recheck.as_ref().is_some_and(|rc| !rc.holds());
+    // What holds the row back, failed drops first.
+    let why = if r.undecided {
+        Some("UNDECIDED: failed drops below it")
+    } else if r.recheck.as_ref().is_some_and(|rc| !rc.holds()) {
+        Some("NOT CONFIRMED by the re-check")
+    } else {
+        None
+    };
     match (r.onset_rpm, r.bracket_rpm) {
         (Some(o), Some([lo, hi])) => format!(
             "{} r/min (bracket {}-{}{})",
             fmt_rpm(o),
             fmt_rpm(lo),
             fmt_rpm(hi),
-            if r.undecided {
-                ", UNDECIDED: failed drops below it"
-            } else if not_confirmed {
-                ", NOT CONFIRMED by the re-check"
-            } else if r.converged {
-                ""
-            } else {
-                ", NOT converged"
-            }
+            why.or((!r.converged).then_some("NOT converged"))
+                .map_or(String::new(), |w| format!(", {w}"))
         ),
         (Some(o), None) => format!(
             "at or below {} r/min (whirl at the lowest speed{})",
             fmt_rpm(o),
-            if r.undecided {
-                "; UNDECIDED: failed drops below it"
-            } else if not_confirmed {
-                "; NOT CONFIRMED by the re-check"
-            } else {
-                ""
-            }
+            why.map_or(String::new(), |w| format!("; {w}"))
         ),
         _ if r.undecided => "UNDECIDED (failed drops)".into(),
-        _ if not_confirmed => "none in the range, NOT CONFIRMED by the re-check".into(),
+        _ if why.is_some() => "none in the range, NOT CONFIRMED by the re-check".into(),
         _ => "none in the range".into(),
     }
 }
