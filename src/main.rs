@@ -427,6 +427,16 @@ fn settings_note(scene: &Scene) -> String {
     }
 }
 
+/// `x` with `decimals` digits after the point, without the sign of a value that rounds to
+/// zero: `-0.0000` for a drop without spin's initial energy of -3e-9 J reads `0.0000`.
+fn fixed(x: f64, decimals: usize) -> String {
+    let s = format!("{x:.decimals$}");
+    match s.strip_prefix('-') {
+        Some(rest) if rest.chars().all(|c| c == '0' || c == '.') => rest.to_string(),
+        _ => s,
+    }
+}
+
 /// Says on standard error which `--set` values the preset `f` replaces (its
 /// [`whirlmap_core::Fidelity::KEYS`], or the whole `solver` section): the preset is applied
 /// after them, so they would otherwise vanish without a word.
@@ -636,8 +646,13 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
         f.final_race_speed_rpm
     );
     outln!(
-        "  energy (J)            initial {:.4} = final {:.4} + friction {:.4} + damping {:.6} + drag {:.4}  (residual {:.1e})",
-        e.initial_j, e.final_j, e.friction_heat_j, e.damping_loss_j, e.drag_work_j, e.residual_rel
+        "  energy (J)            initial {} = final {} + friction {} + damping {} + drag {}  (residual {:.1e})",
+        fixed(e.initial_j, 4),
+        fixed(e.final_j, 4),
+        fixed(e.friction_heat_j, 4),
+        fixed(e.damping_loss_j, 6),
+        fixed(e.drag_work_j, 4),
+        e.residual_rel
     );
     outln!(
         "  work                  {} RHS evaluations, {} steps ({} rejected), {} events, {:.3} s wall",
@@ -788,5 +803,20 @@ fn run() -> u8 {
             errln!("error: {:#}", f.error());
             f.code()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fixed;
+
+    #[test]
+    fn fixed_drops_the_sign_of_a_rounded_zero_only() {
+        assert_eq!(fixed(-3e-9, 4), "0.0000");
+        assert_eq!(fixed(-0.0, 2), "0.00");
+        assert_eq!(fixed(-0.00006, 4), "-0.0001");
+        assert_eq!(fixed(-0.0086, 4), "-0.0086");
+        assert_eq!(fixed(12.25, 1), "12.2");
+        assert_eq!(fixed(f64::NAN, 4), "NaN");
     }
 }

@@ -52,7 +52,13 @@ impl Fidelity {
         Self::ALL
             .into_iter()
             .find(|f| f.name() == text)
-            .ok_or_else(|| InvalidParameter::new("fidelity", text, "draft, standard, reference"))
+            .ok_or_else(|| {
+                InvalidParameter::new(
+                    "fidelity",
+                    format!("{text:?}"),
+                    "draft, standard, reference",
+                )
+            })
     }
 
     /// The relative tolerance of the preset.
@@ -152,6 +158,13 @@ mod tests {
         let e = Fidelity::parse("fast").unwrap_err();
         assert_eq!(e.field, "fidelity");
         assert!(e.to_string().contains("fast") && e.to_string().contains("draft"));
+        // An empty name is shown as one, quoted, not as nothing.
+        let e = Fidelity::parse("").unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("invalid fidelity = \"\": allowed"),
+            "{e}"
+        );
     }
 
     #[test]

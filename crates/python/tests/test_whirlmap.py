@@ -119,7 +119,7 @@ def test_a_bad_value_names_the_field_value_and_range() -> None:
         whirlmap.drop(8000, 0.3, duration_s=-1)
     with pytest.raises(ValueError, match="solver.rtol"):
         whirlmap.drop(8000, 0.3, solver__rtol="tight")
-    with pytest.raises(ValueError, match="fidelity = fast"):
+    with pytest.raises(ValueError, match='fidelity = "fast"'):
         whirlmap.drop(8000, 0.3, fidelity="fast")
 
 
