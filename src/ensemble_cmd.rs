@@ -80,6 +80,7 @@ type Loaded = (ensemble::EnsembleSpec, PathBuf, FolderLock, Option<PathBuf>);
 /// files already there aside.
 fn load(a: &EnsembleArgs, what: &str, resume: bool) -> Result<Loaded, Failure> {
     let s = ensemble::load(&a.file).map_err(|e| Failure::coded(2, e))?;
+    crate::warn_spec_preset_overrides(&a.file);
     // The section the command runs, before any folder is made.
     let (has, section) = match what {
         "adaptive" => (s.adaptive.is_some(), "an adaptive"),

@@ -453,6 +453,28 @@ pub(crate) fn warn_preset_overrides(f: whirlmap_core::Fidelity, sets: &[String])
     }
 }
 
+/// Says on standard error which values of the spec file `path`'s `scene` its `fidelity`
+/// preset replaces ([`whirlmap_sweep::spec::replaced_by_fidelity`]), for a sweep or an
+/// ensemble file that has already been read and checked: they would otherwise vanish without a
+/// word.
+pub(crate) fn warn_spec_preset_overrides(path: &Path) {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return;
+    };
+    let Ok(spec) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return;
+    };
+    let preset = spec["fidelity"].as_str().unwrap_or_default();
+    for (key, value) in whirlmap_sweep::spec::replaced_by_fidelity(&spec) {
+        errln!(
+            "warning: {}: fidelity {preset} sets the numerics, so {key} = {value} has no \
+             effect (leave out fidelity to choose them yourself, or give the value on an axis, \
+             which is applied after the preset)",
+            path.display()
+        );
+    }
+}
+
 /// The integrator settings a drop ran with, and the preset they are, if any: `rodas4, rtol
 /// 1e-4, race tolerance x1000 (the draft preset)`.
 fn numerics_line(scene: &Scene) -> String {

@@ -146,6 +146,7 @@ pub(crate) fn report_failed(out_dir: &Path, failed: usize) {
 /// critical speed undecided or an onset does not hold at the re-check.
 pub fn run(a: &SweepArgs) -> CmdResult {
     let spec = spec::read(&a.file).map_err(|e| Failure::coded(2, e))?;
+    crate::warn_spec_preset_overrides(&a.file);
     if let (Some(i), Some(n)) = (a.shard, a.shards) {
         return crate::shard_cmd::run(a, &spec, i, n);
     }

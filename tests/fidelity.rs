@@ -113,6 +113,57 @@ fn a_preset_says_which_set_values_it_replaces() {
     );
 }
 
+/// A sweep file's `fidelity` replaces the keys of it that its `scene` sets: standard error
+/// names each, and the sweep runs at the preset's numerics. An axis is applied after the
+/// preset, so a value given there is kept, without a word.
+#[test]
+fn a_sweep_file_says_which_scene_values_its_preset_replaces() {
+    let dir = temp_dir("spec-preset");
+    let spec = |name: &str, scene: &str, axes: &str| {
+        let text = format!(
+            r#"{{"name": "{name}", "fidelity": "draft", "duration_s": 0.02, "scene": {scene},
+                "axes": {{"speed_rpm": [2000], "mu": [0.1]{axes}}}}}"#
+        );
+        spec_file(&dir, name, &text)
+    };
+    let run = |file: &std::path::Path| {
+        let out_dir = dir.join(file.file_stem().unwrap());
+        let out = whirlmap(&["sweep", s(file), "--out", s(&out_dir), "--no-progress"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let line = std::fs::read_to_string(out_dir.join("points.jsonl")).unwrap();
+        let rec: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
+        (stderr(&out), rec["scene_hash"].clone())
+    };
+    let replaced = spec(
+        "replaced",
+        r#"{"solver": {"rtol": 1e-6, "max_step_attempts": 100000}}"#,
+        "",
+    );
+    let (err, hash_replaced) = run(&replaced);
+    assert!(
+        err.contains("fidelity draft sets the numerics, so scene.solver.rtol = 1e-6 has no effect"),
+        "{err}"
+    );
+    assert!(!err.contains("max_step_attempts"), "{err}");
+    let (err, hash_plain) = run(&spec(
+        "plain",
+        r#"{"solver": {"max_step_attempts": 100000}}"#,
+        "",
+    ));
+    assert!(!err.contains("warning"), "{err}");
+    assert_eq!(
+        hash_replaced, hash_plain,
+        "the file's rtol was not replaced"
+    );
+    let (err, hash_axis) = run(&spec(
+        "axis",
+        r#"{"solver": {"max_step_attempts": 100000}}"#,
+        r#", "solver.rtol": [1e-6]"#,
+    ));
+    assert!(!err.contains("warning"), "{err}");
+    assert_ne!(hash_axis, hash_plain, "an axis is applied after the preset");
+}
+
 #[test]
 fn accuracy_writes_its_table_and_charts() {
     let dir = std::env::temp_dir().join(format!("whirlmap-acc-{}", std::process::id()));

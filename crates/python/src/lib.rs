@@ -356,13 +356,25 @@ fn sweep(
     Ok(serde_json::to_string(&records).expect("records serialise"))
 }
 
-/// The native module: `drop`, `critical`, `sweep`, `default_scene`, `SimulationError`,
-/// `MODEL_VERSION` and `PRESET_KEYS` (the scene keys a fidelity preset sets).
+/// The scene values of a sweep spec (JSON text) that its `fidelity` preset replaces, as
+/// `(scene.solver.rtol, 1e-6)` pairs ([`spec::replaced_by_fidelity`]); empty when the text is
+/// not JSON (the sweep itself then says why).
+#[pyfunction]
+fn replaced_by_fidelity(text: &str) -> Vec<(String, String)> {
+    serde_json::from_str(text)
+        .map(|v| spec::replaced_by_fidelity(&v))
+        .unwrap_or_default()
+}
+
+/// The native module: `drop`, `critical`, `sweep`, `replaced_by_fidelity`, `default_scene`,
+/// `SimulationError`, `MODEL_VERSION` and `PRESET_KEYS` (the scene keys a fidelity preset
+/// sets).
 #[pymodule]
 fn _whirlmap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(drop_one, m)?)?;
     m.add_function(wrap_pyfunction!(critical, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(replaced_by_fidelity, m)?)?;
     m.add_function(wrap_pyfunction!(default_scene, m)?)?;
     m.add("SimulationError", m.py().get_type::<SimulationError>())?;
     m.add("MODEL_VERSION", MODEL_VERSION)?;

@@ -299,6 +299,24 @@ def test_sweep_rows(tmp_path: Path) -> None:
     assert sorted(x.name for x in tmp_path.iterdir()) == ["tiny.json"]
 
 
+def test_a_sweep_spec_warns_of_the_scene_values_its_preset_replaces(tmp_path: Path) -> None:
+    tiny = {
+        "duration_s": 0.02,
+        "fidelity": "draft",
+        "axes": {"speed_rpm": [2000], "mu": [0.1]},
+    }
+    replaced = {**tiny, "scene": {"solver": {"rtol": 1e-6}}}
+    with pytest.warns(RuntimeWarning, match="scene.solver.rtol = 1e-6 has no effect"):
+        rows = whirlmap.sweep(replaced)
+    path = tmp_path / "replaced.json"
+    path.write_text(json.dumps({"name": "replaced", **replaced}))
+    with pytest.warns(RuntimeWarning, match="replaced.json: its fidelity sets the numerics"):
+        assert whirlmap.sweep(path) == rows
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert whirlmap.sweep(tiny) == rows
+
+
 def test_a_bad_sweep_spec_raises() -> None:
     with pytest.raises(ValueError, match=r"axes.mu = 3|friction coefficient"):
         whirlmap.sweep({**SPEC, "axes": {"mu": [3.0]}})

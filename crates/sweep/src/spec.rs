@@ -591,6 +591,25 @@ fn check_range(field: &str, from: f64, to: f64) -> Result<(), SpecError> {
     }
 }
 
+/// The scene values a spec's `fidelity` preset replaces: each key of
+/// [`Fidelity::KEYS`] that the spec's `scene` sets, as `(scene.solver.rtol, 1e-6)`, in the
+/// order of `KEYS`. Empty without a `fidelity` or when `spec` is not an object. The preset
+/// is applied to the scene after the file's values, so these have no effect; an axis, applied
+/// after the preset, still may vary them. Works on the spec's JSON (a sweep's or an
+/// ensemble's), because a parsed scene cannot tell a value written in the file from a default.
+pub fn replaced_by_fidelity(spec: &Value) -> Vec<(String, String)> {
+    let (Some(Value::String(_)), Some(scene)) = (spec.get("fidelity"), spec.get("scene")) else {
+        return Vec::new();
+    };
+    Fidelity::KEYS
+        .iter()
+        .filter_map(|key| {
+            let value = key.split('.').try_fold(scene, |v, part| v.get(part))?;
+            Some((format!("scene.{key}"), value.to_string()))
+        })
+        .collect()
+}
+
 /// Reads and parses a spec and checks everything but the grid points' scenes
 /// ([`SweepSpec::validate`]: the grid's size first, before any axis is built). A sweep checks
 /// the points' scenes itself before it runs ([`crate::sweep::run_sweep`]), one at a time.
@@ -1134,6 +1153,36 @@ mod tests {
         assert_eq!(plain.points().unwrap()[0].scene.solver.rtol, 1e-6);
         let e = err(|v| v["fidelity"] = "fast".into());
         assert!(e.contains("fast") && e.contains("draft"), "{e}");
+    }
+
+    #[test]
+    fn the_scene_values_a_fidelity_preset_replaces_are_listed() {
+        let mut v: Value = serde_json::from_str(GOOD).unwrap();
+        // No preset: the file's rtol is used, nothing is replaced.
+        assert!(replaced_by_fidelity(&v).is_empty());
+        v["fidelity"] = "draft".into();
+        v["scene"]["quasi_static_race"] = true.into();
+        v["scene"]["solver"]["max_step_attempts"] = 40.into();
+        let listed = replaced_by_fidelity(&v);
+        let want = [
+            ("scene.solver.rtol", "1e-6"),
+            ("scene.quasi_static_race", "true"),
+        ];
+        let want: Vec<(String, String)> = want
+            .iter()
+            .map(|(k, x)| (k.to_string(), x.to_string()))
+            .collect();
+        assert_eq!(listed, want);
+        // What is listed is what the preset does replace, and nothing else is touched.
+        let spec = parse(&v.to_string()).unwrap();
+        let base = spec.base_scene();
+        assert_eq!(base.solver.rtol, Fidelity::Draft.rtol());
+        assert!(!base.quasi_static_race);
+        assert_eq!(base.solver.max_step_attempts, 40);
+        // Not a spec object, or no scene: nothing.
+        assert!(replaced_by_fidelity(&Value::from(3)).is_empty());
+        v.as_object_mut().unwrap().remove("scene");
+        assert!(replaced_by_fidelity(&v).is_empty());
     }
 
     #[test]

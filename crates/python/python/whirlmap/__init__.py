@@ -181,6 +181,20 @@ def _warn_preset_overrides(fidelity: Optional[str], overrides: Dict[str, Any]) -
             )
 
 
+def _warn_spec_preset_overrides(spec_text: str, where: str) -> None:
+    """Warn (``RuntimeWarning``) of each value of a sweep spec's ``scene`` that its
+    ``fidelity`` preset replaces: the preset is applied after them, so they would otherwise
+    vanish without a word. An axis is applied after the preset and may still set them."""
+    for key, value in _whirlmap.replaced_by_fidelity(spec_text):
+        warnings.warn(
+            f"{where}: its fidelity sets the numerics, so {key} = {value} has no effect"
+            " (leave out fidelity to choose them yourself, or give the value on an axis,"
+            " which is applied after the preset)",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+
+
 def default_scene() -> Dict[str, Any]:
     """The default (paper) scene as a dict: every key a scene override may name.
 
@@ -448,9 +462,17 @@ def sweep(
     if isinstance(spec, Mapping):
         spec_dict = dict(spec)
         spec_dict.setdefault("name", "python")
-        text = _whirlmap.sweep(_json(spec_dict, "spec"), None, _threads(threads))
+        spec_text = _json(spec_dict, "spec")
+        _warn_spec_preset_overrides(spec_text, "the spec")
+        text = _whirlmap.sweep(spec_text, None, _threads(threads))
     else:
-        text = _whirlmap.sweep(None, os.fspath(spec), _threads(threads))
+        path = os.fspath(spec)
+        try:
+            with open(path, encoding="utf-8") as f:
+                _warn_spec_preset_overrides(f.read(), path)
+        except (OSError, UnicodeDecodeError):
+            pass  # the sweep below reads it again and raises the error
+        text = _whirlmap.sweep(None, path, _threads(threads))
     points = json.loads(text)
     if not flat:
         return points
