@@ -726,9 +726,38 @@ fn a_sweep_rechecks_its_critical_brackets_when_asked() {
     assert_eq!(rows[0]["converged"], false, "{rows}");
     assert_eq!(rows[1]["recheck"]["confirmed"], true, "{rows}");
     assert_eq!(rows[1]["recheck"]["fidelity"], "standard", "{rows}");
-    assert!(std::fs::read_to_string(out_dir.join("critical.csv"))
-        .unwrap()
-        .contains("NOT CONFIRMED by the re-check at standard"));
+    let csv = std::fs::read_to_string(out_dir.join("critical.csv")).unwrap();
+    assert!(csv.contains("NOT CONFIRMED by the re-check at standard"));
+    // The re-check's own columns: its preset, whether the onset holds, the onset at that
+    // preset (the one searched again where it does not hold) and its drops.
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let columns = header.len();
+    let cell = |row: usize, name: &str| {
+        let line = csv.lines().nth(row + 1).unwrap();
+        let at = header.iter().position(|h| *h == name).unwrap();
+        line.splitn(columns, ',').nth(at).unwrap().to_string()
+    };
+    for (i, holds) in [(0, "false"), (1, "true")] {
+        let rc = &rows[i]["recheck"];
+        assert_eq!(cell(i, "recheck_fidelity"), "standard");
+        assert_eq!(cell(i, "recheck_holds"), holds);
+        let found = match i {
+            0 => rc["relocated"]["onset_rpm"].as_f64(),
+            _ => rows[i]["onset_rpm"].as_f64(),
+        };
+        assert_eq!(
+            cell(i, "recheck_onset_rpm"),
+            found.map_or(String::new(), |x| x.to_string())
+        );
+        let cells = rc["lo"].is_array() as u64 + rc["hi"].is_array() as u64;
+        let window = rc["relocated"]["drops"].as_u64().unwrap_or(0);
+        assert_eq!(
+            cell(i, "recheck_drops"),
+            (cells + window).to_string(),
+            "{rc}"
+        );
+    }
+    assert!(!cell(0, "recheck_onset_rpm").is_empty(), "{csv}");
     let cli = whirlmap(&[
         "critical",
         "--json",

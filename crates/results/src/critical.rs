@@ -129,11 +129,13 @@ pub struct CriticalRow {
 }
 
 /// The header of `critical.csv`.
-pub const CSV_HEADER: &str = "mu,onset_rpm,bracket_below_rpm,bracket_above_rpm,class_below,class_above,whirl_intervals_rpm,whirl_at_range_top,non_monotone,drops,failed_drops,converged,undecided,from_rpm,to_rpm,resolution_rpm,tol_rpm,note";
+pub const CSV_HEADER: &str = "mu,onset_rpm,bracket_below_rpm,bracket_above_rpm,class_below,class_above,whirl_intervals_rpm,whirl_at_range_top,non_monotone,drops,failed_drops,converged,undecided,from_rpm,to_rpm,resolution_rpm,tol_rpm,recheck_fidelity,recheck_holds,recheck_onset_rpm,recheck_drops,note";
 
 impl CriticalRow {
     /// The row's line of `critical.csv` (see [`CSV_HEADER`]): intervals as
-    /// `first-last` separated by `;`, empty cells for nulls, the note quoted.
+    /// `first-last` separated by `;`, empty cells for nulls, the note quoted. The re-check's
+    /// four cells are empty for a row without one; `recheck_onset_rpm` is
+    /// [`Recheck::onset_rpm`].
     pub fn csv_line(&self) -> String {
         let opt = |v: Option<f64>| v.map_or(String::new(), |x| x.to_string());
         let class = |c: Option<OrbitClass>| c.map_or("", |c| c.name()).to_string();
@@ -143,6 +145,7 @@ impl CriticalRow {
             .map(|[a, b]| format!("{a}-{b}"))
             .collect::<Vec<_>>()
             .join(";");
+        let rc = self.recheck.as_ref();
         [
             self.mu.to_string(),
             opt(self.onset_rpm),
@@ -161,6 +164,10 @@ impl CriticalRow {
             self.to_rpm.to_string(),
             self.resolution_rpm.to_string(),
             self.tol_rpm.to_string(),
+            rc.map_or(String::new(), |rc| rc.fidelity.name().to_string()),
+            rc.map_or(String::new(), |rc| rc.holds().to_string()),
+            opt(rc.and_then(|rc| rc.onset_rpm(self.onset_rpm))),
+            rc.map_or(String::new(), |rc| rc.drops().to_string()),
             format!("\"{}\"", self.note.replace('"', "'")),
         ]
         .join(",")
@@ -294,6 +301,18 @@ impl Recheck {
     pub fn onset_within(&self, onset_rpm: Option<f64>, tol_rpm: f64) -> bool {
         let found = self.relocated.as_ref().and_then(|r| r.onset_rpm);
         matches!((found, onset_rpm), (Some(a), Some(b)) if (a - b).abs() <= tol_rpm)
+    }
+
+    /// The onset at the re-check's preset, for a row whose search put it at `row_onset_rpm`:
+    /// that onset when the preset confirms the cells (its bracket then lies within the same
+    /// cells), else the onset searched again there (`relocated`), null when that search found
+    /// none. Null for a row without an onset whose range end is confirmed.
+    pub fn onset_rpm(&self, row_onset_rpm: Option<f64>) -> Option<f64> {
+        if self.confirmed {
+            row_onset_rpm
+        } else {
+            self.relocated.as_ref().and_then(|r| r.onset_rpm)
+        }
     }
 
     /// The cells re-run, lower first.
@@ -484,5 +503,43 @@ mod tests {
         let json = serde_json::to_string(not_held.recheck.as_ref().unwrap()).unwrap();
         assert!(!json.contains("within_tol"), "{json}");
         assert!(unconfirmed_summary(&[not_held]).is_some());
+    }
+
+    /// `critical.csv`'s re-check cells: the preset, whether the onset holds, the onset at
+    /// that preset and the drops the re-check ran; empty without a re-check.
+    #[test]
+    fn the_csv_says_what_the_re_check_found() {
+        let cells = |r: &CriticalRow| {
+            let line = r.csv_line();
+            // The note, last, may hold commas; it is quoted.
+            let columns = CSV_HEADER.split(',').count();
+            let fields: Vec<&str> = line.splitn(columns, ',').collect();
+            assert_eq!(fields.len(), columns, "{line}");
+            assert!(fields[columns - 1].starts_with('"'), "{line}");
+            fields[17..21].join(",")
+        };
+        let plain = row(false, "pendulum at 13312.5 r/min");
+        assert_eq!(cells(&plain), ",,,");
+        let mut confirmed = plain.clone();
+        recheck(true).apply_to(&mut confirmed);
+        assert_eq!(cells(&confirmed), "standard,true,13375,2");
+        let mut lost = plain.clone();
+        recheck(false).apply_to(&mut lost);
+        assert_eq!(cells(&lost), "standard,false,,2");
+        let mut moved = plain.clone();
+        let mut rc = recheck(false);
+        rc.relocated = Some(Relocated {
+            window_rpm: [11000.0, 16000.0],
+            onset_rpm: Some(12500.0),
+            drops: 7,
+            note: "its onset there 12500 r/min".into(),
+        });
+        rc.apply_to(&mut moved);
+        assert_eq!(cells(&moved), "standard,false,12500,9");
+        // No whirl in the range, confirmed at the range top: no onset at either preset.
+        let mut none = plain.clone();
+        none.onset_rpm = None;
+        recheck(true).apply_to(&mut none);
+        assert_eq!(cells(&none), "standard,true,,2");
     }
 }
