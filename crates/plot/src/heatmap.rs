@@ -21,8 +21,25 @@ use crate::render::{
 use plotters::element::DashedPathElement;
 use whirlmap_results::point::PointStatus;
 
-/// Cell edges around increasing centres: midpoints, extended by half a step at the ends.
+/// Cell edges around increasing centres: midpoints, extended by half a step at the ends; the
+/// first edge no lower than 0 when every centre is above 0 (no cell of a friction or speed
+/// axis reaches below zero: mu 0.05 and 0.3 give `[0, 0.175, 0.425]`, not from -0.075). A
+/// cell centred on 0 keeps its lower half.
 pub(crate) fn edges(centres: &[f64]) -> Vec<f64> {
+    let mut e = open_edges(centres);
+    if centres.len() >= 2 && centres[0] > 0.0 {
+        e[0] = e[0].max(0.0);
+    }
+    e
+}
+
+/// Whether [`edges`] clips the first cell at 0, so that its drop is not at its middle.
+pub(crate) fn clipped_at_zero(centres: &[f64]) -> bool {
+    centres.len() >= 2 && centres[0] > 0.0 && open_edges(centres)[0] < 0.0
+}
+
+/// [`edges`] without the floor at 0.
+fn open_edges(centres: &[f64]) -> Vec<f64> {
     match centres.len() {
         0 => vec![0.0, 1.0],
         1 => {
@@ -292,7 +309,8 @@ impl Figure for GridFigure<'_> {
         let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
         let (bw, bh) = body.dim_in_pixel();
         // On an uneven grid, a dot marks where each drop was, and the legend says so.
-        let drops_marked = uneven(&g.speeds_rpm) || uneven(&g.mus);
+        let uneven_grid = uneven(&g.speeds_rpm) || uneven(&g.mus);
+        let drops_marked = uneven_grid || clipped_at_zero(&g.speeds_rpm) || clipped_at_zero(&g.mus);
         let legend_h = if self.whirl_label.is_some() || limit.is_some() {
             66
         } else {
@@ -626,7 +644,12 @@ impl Figure for GridFigure<'_> {
             entries.push((Mark::Swatch(WHITE), "no data".to_string()));
         }
         if drops_marked {
-            entries.push((Mark::Drop, "drop (uneven grid)".to_string()));
+            let why = if uneven_grid {
+                "uneven grid"
+            } else {
+                "first cell clipped at 0"
+            };
+            entries.push((Mark::Drop, format!("drop ({why})")));
         }
         legend(&legend_band, &entries)?;
 
@@ -688,7 +711,9 @@ fn connected_pieces(ends: &[[(i32, i32); 2]]) -> Vec<Vec<usize>> {
 
 #[cfg(test)]
 mod tests {
-    use super::{colour_scale, connected_pieces, uneven, Metric, MIN_RELATIVE_SPAN};
+    use super::{
+        clipped_at_zero, colour_scale, connected_pieces, edges, uneven, Metric, MIN_RELATIVE_SPAN,
+    };
 
     /// On a log colour bar, ticks a tenth of the span apart read differently at every span
     /// down to the floor (1 % of the values), where two significant figures once repeated;
@@ -748,6 +773,25 @@ mod tests {
                 "{v}: {lo} {hi}"
             );
         }
+    }
+
+    #[test]
+    fn no_cell_reaches_below_zero_on_a_non_negative_axis() {
+        let e = edges(&[0.05, 0.3]);
+        assert_eq!(e[0], 0.0);
+        assert!((e[1] - 0.175).abs() < 1e-15 && (e[2] - 0.425).abs() < 1e-15);
+        assert!(clipped_at_zero(&[0.05, 0.3]));
+        // Half a step fits below the first centre: nothing is clipped.
+        assert_eq!(edges(&[2000.0, 4000.0])[0], 1000.0);
+        assert!(!clipped_at_zero(&[2000.0, 4000.0]) && !clipped_at_zero(&[0.0, 0.1]));
+        assert_eq!(
+            edges(&[0.0, 0.1])[0],
+            -0.05,
+            "a centre at 0 keeps its whole cell"
+        );
+        // An axis that goes below zero (speeds of the other spin direction) is left alone.
+        assert_eq!(edges(&[-1000.0, 1000.0])[0], -2000.0);
+        assert!(!clipped_at_zero(&[-1000.0, 1000.0]) && !clipped_at_zero(&[0.01]));
     }
 
     #[test]
