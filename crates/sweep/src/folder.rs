@@ -184,10 +184,21 @@ pub fn running_writer(dir: &Path) -> Option<String> {
 pub fn output_error(dir: &Path, source: std::io::Error) -> SweepError {
     // A file where the folder should be: said in words, not as "File exists (os error 17)".
     let in_the_way = source.kind() == std::io::ErrorKind::AlreadyExists;
+    // A file where a parent folder should be: named, not "Not a directory (os error 20)".
+    let file_above = dir
+        .ancestors()
+        .skip(1)
+        .find(|a| !a.as_os_str().is_empty() && a.exists())
+        .filter(|a| !a.is_dir());
     let source = if in_the_way && dir.exists() && !dir.is_dir() {
         std::io::Error::new(
             std::io::ErrorKind::AlreadyExists,
             "it is a file, not a folder (give --out a folder)",
+        )
+    } else if let Some(file) = file_above {
+        std::io::Error::new(
+            std::io::ErrorKind::NotADirectory,
+            format!("{} is a file, not a folder", file.display()),
         )
     } else {
         source

@@ -1412,12 +1412,15 @@ mod tests {
         ));
         let file = dir.join("a-file");
         std::fs::write(&file, "x").unwrap();
-        let e = check_output_dir(&file.join("sub")).unwrap_err();
+        let e = check_output_dir(&file.join("sub").join("deeper")).unwrap_err();
         assert!(
             matches!(e, crate::sweep::SweepError::Spec(SpecError::Output { .. })),
             "{e}"
         );
         assert_eq!(e.exit_code(), 2);
+        // The file above the folder is named, not "Not a directory (os error 20)".
+        let named = format!("{} is a file, not a folder", file.display());
+        assert!(e.to_string().ends_with(&named), "{e}");
         // The file itself as the folder: said in words, exit 2.
         let e = check_output_dir(&file).unwrap_err();
         assert!(e.to_string().contains("is a file, not a folder"), "{e}");
