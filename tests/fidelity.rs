@@ -132,6 +132,16 @@ fn a_sweep_file_says_which_scene_values_its_preset_replaces() {
         assert!(out.status.success(), "{}", stderr(&out));
         let line = std::fs::read_to_string(out_dir.join("points.jsonl")).unwrap();
         let rec: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
+        // The manifest gives the numerics the preset set beside the spec's own scene.
+        let manifest = read_json(&out_dir.join("manifest.json"));
+        let preset = &manifest["preset_solver"];
+        assert_eq!(preset["rtol"], 1e-4, "{manifest}");
+        assert_eq!(preset["method"], "rodas4", "{manifest}");
+        assert_eq!(preset["race_atol_scale"], 1000.0, "{manifest}");
+        assert_eq!(
+            preset["max_step_attempts"], 100000,
+            "the file's other keys stay"
+        );
         (stderr(&out), rec["scene_hash"].clone())
     };
     let replaced = spec(

@@ -95,6 +95,13 @@ pub struct Counts {
 pub struct Manifest<S> {
     /// The spec, as parsed.
     pub spec: S,
+    /// With a `fidelity` preset in the spec: the integrator settings every drop started from,
+    /// the spec's `scene.solver` with the preset applied (an axis may still vary them; the
+    /// preset also runs the full model, `quasi_static_race` off). The spec's own
+    /// `scene.solver` is what the file gave, which the preset replaced. Absent without a
+    /// preset.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset_solver: Option<whirlmap_core::SolverSettings>,
     /// The spec's hash.
     pub spec_hash: String,
     /// The whirlmap version of the binary that ran the drops.
@@ -255,6 +262,10 @@ pub struct EnsembleManifest<S> {
     pub git_commit: Option<String>,
     /// The model version of the binary that ran them.
     pub model_version: u32,
+    /// With a `fidelity` preset in the spec: the integrator settings every drop started
+    /// from, as [`Manifest::preset_solver`]. Absent without a preset.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset_solver: Option<whirlmap_core::SolverSettings>,
     /// The ensemble spec.
     pub spec: SortedKeys<S>,
     /// Worker threads.
@@ -323,6 +334,7 @@ mod tests {
             failed: 0,
             git_commit: Some("abc".into()),
             model_version: 5,
+            preset_solver: None,
             spec: SortedKeys(serde_json::json!({"name": "e", "axes": {}})),
             threads: 2,
             wall_time_s: 0.5,

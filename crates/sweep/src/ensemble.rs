@@ -1055,6 +1055,7 @@ fn manifest(
         failed,
         git_commit: Some(crate::build_info::GIT_COMMIT.to_string()),
         model_version: whirlmap_core::MODEL_VERSION,
+        preset_solver: spec.fidelity.map(|f| f.applied(&spec.scene).solver),
         spec: SortedKeys(spec),
         threads: rayon::current_num_threads(),
         wall_time_s,

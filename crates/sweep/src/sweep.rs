@@ -487,6 +487,7 @@ pub(crate) fn write_manifest(
 ) -> Result<(), SweepError> {
     let manifest = Manifest {
         spec: &r.spec,
+        preset_solver: r.spec.fidelity.map(|_| r.spec.base_scene().solver),
         spec_hash: r.spec_hash.clone(),
         whirlmap_version: r.meta.whirlmap_version.clone(),
         model_version: MODEL_VERSION,
