@@ -130,7 +130,10 @@ fn load(a: &EnsembleArgs, what: &str, resume: bool) -> Result<Loaded, Failure> {
     let previous = if a.overwrite {
         whirlmap_sweep::folder::move_owned_aside(&out).map_err(failure)?
     } else {
-        None
+        // A resume finishing a killed `--overwrite`: what that moved aside goes once the
+        // results are written, as it would have.
+        let prev = out.join(whirlmap_sweep::results::files::PREVIOUS_DIR);
+        (resume && prev.is_dir()).then_some(prev)
     };
     Ok((s, out, lock, previous))
 }

@@ -425,6 +425,36 @@ fn a_killed_ensemble_keeps_its_members_and_resumes_to_the_uninterrupted_files() 
         (m["complete"].clone(), m["drops"].clone()),
         (true.into(), 40.into())
     );
+    // An --overwrite killed part way keeps the finished run in previous-run/; the --resume
+    // that finishes it removes that, as the overwrite would have.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_whirlmap"))
+        .args(["ensemble", s(&spec), "--out", s(&killed), "--overwrite"])
+        .args(["--threads", "2", "--no-progress"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let lines = || {
+        std::fs::read_to_string(killed.join("members.jsonl")).map_or(0, |t| t.matches('\n').count())
+    };
+    while !(killed.join("previous-run").exists() && (2..40).contains(&lines())) {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "it ended before the kill"
+        );
+        assert!(start.elapsed().as_secs() < 120, "no progress");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(killed.join("previous-run/members.jsonl").exists());
+    let o = whirlmap(&["ensemble", s(&spec), "--out", s(&killed), "--resume"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!killed.join("previous-run").exists());
+    for f in OUTPUTS {
+        assert_eq!(read(&full.join(f)), read(&killed.join(f)), "{f}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
