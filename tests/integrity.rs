@@ -377,6 +377,61 @@ fn a_run_owns_its_folder_and_stale_files_are_never_used() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A user's files in `charts/` and `orbits/` are left alone: by `render`, which removes only
+/// the stale charts of whirlmap's names, by `--overwrite`, which moves aside only whirlmap's
+/// files, and by `--resume`, which makes the charts again. None of them is listed in the
+/// manifest as the run's.
+#[test]
+fn a_users_files_in_charts_and_orbits_are_left_alone() {
+    let dir = temp_dir("users-files");
+    let spec_text = tiny_with_charts(r#"["classes", "orbits"]"#);
+    let body = spec_text.trim_end().strip_suffix('}').unwrap();
+    let spec = spec_file(
+        &dir,
+        "t",
+        &format!(r#"{body}, "orbits": {{"speed_rpm": 4000, "mu": [0.3]}}}}"#),
+    );
+    let out = dir.join("out");
+    let o = sweep(&spec, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    let mine = [out.join("charts/my_plot.png"), out.join("orbits/notes.txt")];
+    for f in &mine {
+        std::fs::write(f, "mine").unwrap();
+    }
+    // A chart of whirlmap's name that this spec does not draw is stale: render removes it.
+    std::fs::write(out.join("charts/fig5_max_force.png"), "old").unwrap();
+    let kept = |when: &str| {
+        for f in &mine {
+            assert_eq!(
+                std::fs::read_to_string(f).ok().as_deref(),
+                Some("mine"),
+                "{when}"
+            );
+        }
+        let m = read_json(&out.join("manifest.json"));
+        let files = m["files"].as_object().unwrap();
+        assert!(files.contains_key("charts/classes.png"), "{when}: {m}");
+        assert!(
+            files
+                .keys()
+                .all(|k| !k.contains("my_plot") && !k.contains("notes")),
+            "{when}: {m}"
+        );
+    };
+    let o = whirlmap(&["render", s(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    assert!(!out.join("charts/fig5_max_force.png").exists());
+    kept("render");
+    let o = sweep(&spec, &out, &["--overwrite"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    assert!(!out.join("previous-run").exists());
+    kept("--overwrite");
+    let o = sweep(&spec, &out, &["--resume"]);
+    assert_eq!(o.status.code(), Some(0), "{}", out_text(&o));
+    kept("--resume");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn huge_grids_are_refused_at_once() {
     let dir = temp_dir("huge");

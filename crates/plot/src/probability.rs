@@ -244,7 +244,9 @@ pub fn render_probability(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
     };
     let mut written = Vec::new();
     for ext in ["png", "svg"] {
-        let p = out.join(format!("fig4_probability.{ext}"));
+        let name = format!("fig4_probability.{ext}");
+        debug_assert!(whirlmap_results::files::is_chart_file(&name), "{name}");
+        let p = out.join(name);
         render(&p, CHART_SIZE, &figure)?;
         written.push(p);
     }

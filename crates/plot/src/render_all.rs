@@ -22,7 +22,10 @@ pub(crate) fn write_both<F: Figure>(
     written: &mut Vec<PathBuf>,
 ) -> Result<(), ChartError> {
     for ext in ["png", "svg"] {
-        let path = out_dir.join(format!("{stem}.{ext}"));
+        let name = format!("{stem}.{ext}");
+        // What render, --overwrite and --resume may remove is known by these names.
+        debug_assert!(whirlmap_results::files::is_chart_file(&name), "{name}");
+        let path = out_dir.join(name);
         render(&path, size, figure)?;
         written.push(path);
     }
@@ -191,15 +194,15 @@ pub const FIG3_ORBITS: &str = "fig3_orbits";
 
 /// Removes the charts in `dir` that this rendering did not draw (a Fig. 4 left from an
 /// earlier spec with a critical search, say), so `charts/` shows only what the data holds.
+/// Only whirlmap's charts ([`whirlmap_results::files::is_chart_file`]) are removed: a file of
+/// the user's in `charts/` stays.
 pub(crate) fn remove_stale_charts(dir: &Path, written: &[PathBuf]) -> Result<(), ChartError> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(());
     };
     for e in entries.flatten() {
         let p = e.path();
-        let chart = p
-            .extension()
-            .is_some_and(|x| x.eq_ignore_ascii_case("png") || x.eq_ignore_ascii_case("svg"));
+        let chart = whirlmap_results::files::is_chart_file(&e.file_name().to_string_lossy());
         if chart && p.is_file() && !written.iter().any(|w| w == &p) {
             std::fs::remove_file(&p).map_err(|cause| ChartError::Write {
                 path: p.clone(),

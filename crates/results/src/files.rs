@@ -64,6 +64,33 @@ pub const STUDY_FILE: &str = "study.json";
 /// evaluations, and against wall time.
 pub const WORK_PRECISION_CHARTS: [&str; 2] = ["work_precision", "work_precision_wall"];
 
+/// The stems of every chart whirlmap draws into a [`CHARTS_DIR`] (each as `.png` and `.svg`):
+/// a sweep's and an ensemble's.
+pub const CHART_STEMS: [&str; 9] = [
+    "fig3_orbits",
+    "fig4_critical",
+    "fig4_probability",
+    "fig5_max_force",
+    "fig6_peak_power",
+    "classes",
+    "peak_temperature",
+    "drops_to_failure",
+    "contact_pressure",
+];
+
+/// Whether `name`, a file in a [`CHARTS_DIR`], is a chart whirlmap draws ([`CHART_STEMS`],
+/// `.png` or `.svg`): the only files there that `render`, `--overwrite` and `--resume` remove.
+pub fn is_chart_file(name: &str) -> bool {
+    name.rsplit_once('.')
+        .is_some_and(|(stem, ext)| matches!(ext, "png" | "svg") && CHART_STEMS.contains(&stem))
+}
+
+/// Whether `name`, a file in an [`ORBITS_DIR`], is one whirlmap writes there: an orbit
+/// ([`orbit_file`]) or a failed panel's error ([`orbit_error_file`]).
+pub fn is_orbit_file(name: &str) -> bool {
+    name.ends_with(".json") || name.ends_with(".error.txt")
+}
+
 /// The file name of a recorded orbit (in [`ORBITS_DIR`]): `stem.json`.
 pub fn orbit_file(stem: &str) -> String {
     format!("{stem}.json")

@@ -16,7 +16,9 @@
 //! [`crate::extras::run_all_owned`]; every other derived
 //! file is removed and made again) or `--overwrite` (the old files are
 //! moved into [`PREVIOUS_DIR`] and deleted once the new run's first records are synced to
-//! disk, so a rerun killed early loses nothing). Other files are left alone and never read.
+//! disk, so a rerun killed early loses nothing). Other files are left alone and never read,
+//! in the owned subfolders too: `charts/` and `orbits/` are moved and removed file by file,
+//! only whirlmap's ([`is_whirlmaps`]).
 //!
 //! ## The manifest's file list
 //! `manifest.json` is written when a run starts (`complete: false`) and rewritten after each
@@ -344,9 +346,7 @@ impl RunFolder {
             ))),
             Mode::Resume => {
                 check_resumable(dir, id)?;
-                for name in DERIVED {
-                    remove_path(&dir.join(name))?;
-                }
+                take_owned(dir, DERIVED, None)?;
                 if dir.join(PREVIOUS_DIR).exists() {
                     folder.previous = Some(dir.join(PREVIOUS_DIR));
                 }
@@ -373,17 +373,17 @@ impl RunFolder {
         let current_has_records = std::fs::read(self.dir.join(POINTS_FILE))
             .map(|b| b.contains(&b'\n'))
             .unwrap_or(false);
+        let present: Vec<&str> = present
+            .iter()
+            .copied()
+            .filter(|n| *n != PREVIOUS_DIR)
+            .collect();
         if prev.exists() && !current_has_records {
-            for name in present.iter().filter(|n| **n != PREVIOUS_DIR) {
-                remove_path(&self.dir.join(name))?;
-            }
+            take_owned(&self.dir, &present, None)?;
         } else {
             remove_path(&prev)?;
             std::fs::create_dir(&prev).map_err(io_err(&prev))?;
-            for name in present.iter().filter(|n| **n != PREVIOUS_DIR) {
-                let from = self.dir.join(name);
-                std::fs::rename(&from, prev.join(name)).map_err(io_err(&from))?;
-            }
+            take_owned(&self.dir, &present, Some(&prev))?;
         }
         sync_dir(&self.dir);
         self.previous = Some(prev);
@@ -427,7 +427,10 @@ impl RunFolder {
                         .map(|c| c.as_os_str().to_string_lossy())
                         .collect::<Vec<_>>()
                         .join("/");
-                    self.record(&r)?;
+                    // A user's file in charts/ or orbits/ is not the run's.
+                    if is_whirlmaps(&r) {
+                        self.record(&r)?;
+                    }
                 }
             }
         }
@@ -473,17 +476,12 @@ pub fn move_owned_aside(dir: &Path) -> Result<Option<PathBuf>, SweepError> {
         .collect();
     let prev = dir.join(PREVIOUS_DIR);
     if prev.symlink_metadata().is_ok() {
-        for name in &present {
-            remove_path(&dir.join(name))?;
-        }
+        take_owned(dir, &present, None)?;
     } else if present.is_empty() {
         return Ok(None);
     } else {
         std::fs::create_dir(&prev).map_err(io_err(&prev))?;
-        for name in &present {
-            let from = dir.join(name);
-            std::fs::rename(&from, prev.join(name)).map_err(io_err(&from))?;
-        }
+        take_owned(dir, &present, Some(&prev))?;
     }
     sync_dir(dir);
     Ok(Some(prev))
@@ -496,6 +494,69 @@ pub fn release_previous(prev: Option<PathBuf>) -> Result<(), SweepError> {
         if let Some(dir) = p.parent() {
             sync_dir(dir);
         }
+    }
+    Ok(())
+}
+
+/// Whether the file at `rel` (`/`-separated, relative to a results folder) is one whirlmap
+/// writes: in a `charts/` folder only its charts ([`whirlmap_results::files::is_chart_file`]),
+/// in an `orbits/` folder only orbit and error files, in `probability/` (an ensemble's folder)
+/// only the names of [`OWNED`]; anywhere else, any file (the lists it is asked about hold
+/// only whirlmap's names).
+pub fn is_whirlmaps(rel: &str) -> bool {
+    let (parent, name) = rel.rsplit_once('/').unwrap_or(("", rel));
+    let sub = parent.rsplit('/').next().unwrap_or(parent);
+    match sub {
+        CHARTS_DIR => whirlmap_results::files::is_chart_file(name),
+        ORBITS_DIR => whirlmap_results::files::is_orbit_file(name),
+        _ if parent == PROBABILITY_DIR => OWNED.contains(&name),
+        _ => true,
+    }
+}
+
+/// Moves into `to` (or, with `None`, removes) the entries `names` of the folder `from` that
+/// are whirlmap's, leaving a user's files in place: `charts/` and `orbits/` go file by file
+/// ([`is_whirlmaps`]), `probability/` (an ensemble's folder) entry by entry, each of them
+/// removed once empty; any other name goes whole. Absent names are skipped.
+fn take_owned(from: &Path, names: &[&str], to: Option<&Path>) -> Result<(), SweepError> {
+    for name in names {
+        let src = from.join(name);
+        let Ok(meta) = src.symlink_metadata() else {
+            continue;
+        };
+        let dest = to.map(|t| t.join(name));
+        let by_entry = [CHARTS_DIR, ORBITS_DIR, PROBABILITY_DIR].contains(name);
+        if !(meta.is_dir() && by_entry) {
+            match &dest {
+                Some(d) => std::fs::rename(&src, d).map_err(io_err(&src))?,
+                None => remove_path(&src)?,
+            }
+            continue;
+        }
+        if let Some(d) = &dest {
+            std::fs::create_dir_all(d).map_err(io_err(d))?;
+        }
+        let entries: Vec<String> = std::fs::read_dir(&src)
+            .map_err(io_err(&src))?
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        let inner: Vec<&str> = if *name == PROBABILITY_DIR {
+            OWNED
+                .iter()
+                .copied()
+                .filter(|n| entries.iter().any(|e| e == n))
+                .collect()
+        } else {
+            entries
+                .iter()
+                .map(String::as_str)
+                .filter(|n| src.join(n).is_file() && is_whirlmaps(&format!("{name}/{n}")))
+                .collect()
+        };
+        take_owned(&src, &inner, dest.as_deref())?;
+        // Gone when nothing else was in it; kept, with the user's files, otherwise.
+        let _ = std::fs::remove_dir(&src);
     }
     Ok(())
 }
@@ -851,7 +912,6 @@ pub fn relist_tree(dir: &Path, rel: &str) -> Result<(), SweepError> {
         }
     }
     for p in found {
-        let entry = FileEntry::of(&p).map_err(io_err(&p))?;
         let r = p
             .strip_prefix(dir)
             .unwrap_or(&p)
@@ -859,7 +919,10 @@ pub fn relist_tree(dir: &Path, rel: &str) -> Result<(), SweepError> {
             .map(|c| c.as_os_str().to_string_lossy())
             .collect::<Vec<_>>()
             .join("/");
-        m.files.insert(r, entry);
+        if is_whirlmaps(&r) {
+            let entry = FileEntry::of(&p).map_err(io_err(&p))?;
+            m.files.insert(r, entry);
+        }
     }
     let again = m.to_text();
     if again == text {
@@ -871,6 +934,30 @@ pub fn relist_tree(dir: &Path, rel: &str) -> Result<(), SweepError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn whirlmaps_files_are_told_from_a_users() {
+        for rel in [
+            "points.jsonl",
+            "charts/classes.png",
+            "charts/fig4_critical.svg",
+            "orbits/00_8000rpm_mu0.100.json",
+            "orbits/01_8000rpm_mu0.200.error.txt",
+            "probability/members.jsonl",
+            "probability/charts/fig4_probability.png",
+        ] {
+            assert!(is_whirlmaps(rel), "{rel}");
+        }
+        for rel in [
+            "charts/my_plot.png",
+            "charts/classes.pdf",
+            "orbits/notes.txt",
+            "probability/notes.md",
+            "probability/charts/mine.svg",
+        ] {
+            assert!(!is_whirlmaps(rel), "{rel}");
+        }
+    }
 
     #[test]
     fn the_studies_charts_are_owned_names() {
