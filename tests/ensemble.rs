@@ -92,6 +92,40 @@ fn same_seed_same_bytes_for_one_and_two_threads() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The axes listed in the other order give each cell the same members: the same cells, by
+/// their inputs, with the same statistics (only their order in the files differs).
+#[test]
+fn the_order_of_the_axes_does_not_change_a_cells_members() {
+    let dir = temp_dir("axis-order");
+    let text = read(&smoke());
+    let swapped = text.replace(
+        r#""speed_rpm": [4000, 8000],
+    "mu": [0.3, 0.4]"#,
+        r#""mu": [0.3, 0.4],
+    "speed_rpm": [4000, 8000]"#,
+    );
+    assert_ne!(swapped, text, "the smoke file's axes moved");
+    let swapped = spec_file(&dir, "swapped", &swapped);
+    let cells = |spec: &Path, out: &Path| {
+        let o = whirlmap(&["ensemble", s(spec), "--out", s(out), "--no-progress"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let mut rows: Vec<serde_json::Value> = read(&out.join("cells.jsonl"))
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        for r in &mut rows {
+            r.as_object_mut().unwrap().remove("index");
+        }
+        rows.sort_by_key(|r| r["inputs"].to_string());
+        rows
+    };
+    let a = cells(&smoke(), &dir.join("a"));
+    let b = cells(&swapped, &dir.join("b"));
+    assert_eq!(a.len(), 4);
+    assert_eq!(a, b);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn another_seed_draws_other_members() {
     let dir = temp_dir("seed");

@@ -29,8 +29,9 @@
 //!
 //! ## Random numbers
 //! Each member's numbers come from its own generator, seeded by hashing (spec seed, the
-//! cell's inputs, member index, quantity name): results do not depend on thread count, on
-//! the order cells run in, on the grid around the cell (a cell at the same inputs gets the
+//! cell's inputs by axis name, member index, quantity name): results do not depend on thread
+//! count, on the order cells run in, on the order the spec lists its axes in, on the grid
+//! around the cell (a cell at the same inputs gets the
 //! same members in another grid, which the adaptive search relies on), or on which other
 //! quantities are drawn. The generator is SplitMix64 ([`SplitMix64`]), hand-written so the
 //! numbers are fixed by this file, not by a crate's version (rand's samplers changed their
@@ -328,12 +329,15 @@ impl EnsembleParams {
     }
 
     /// The member's scene: `cell` with its draws applied, and what was drawn. The numbers
-    /// depend only on (seed, `inputs`, `member`, quantity).
+    /// depend only on (seed, `inputs`, `member`, quantity), the inputs by axis name: not on
+    /// the order the spec lists its axes in.
     pub fn member_scene(&self, cell: &Scene, inputs: &Inputs, member: usize) -> (Scene, Drawn) {
+        let mut by_name = inputs.0.clone();
+        by_name.sort_by(|a, b| a.0.cmp(&b.0));
         let base = format!(
             "whirlmap-ensemble|{}|{}|{member}",
             self.seed,
-            serde_json::to_string(inputs).expect("inputs serialise")
+            serde_json::to_string(&Inputs(by_name)).expect("inputs serialise")
         );
         let draw = |name: &str, d: &Dist| {
             let mut rng = SplitMix64::new(fnv1a64(format!("{base}|{name}").as_bytes()));
@@ -1594,6 +1598,14 @@ mod tests {
         assert_eq!(a, b);
         let (c, _) = p.member_scene(&scene, &inputs, 3);
         assert_ne!(a.unbalance_m, c.unbalance_m);
+        // The axes in the other order: the same cell, the same members.
+        let swapped = Inputs(vec![("mu".into(), 0.3), ("speed_rpm".into(), 8000.0)]);
+        assert_eq!(p.member_scene(&scene, &swapped, 2), (a.clone(), da.clone()));
+        let other = Inputs(vec![("mu".into(), 0.3), ("speed_rpm".into(), 9000.0)]);
+        assert_ne!(
+            p.member_scene(&scene, &other, 2).0.unbalance_m,
+            a.unbalance_m
+        );
         let mut q = p.clone();
         q.seed = 10;
         assert_ne!(
