@@ -1600,7 +1600,7 @@ mod tests {
         assert_ne!(a.unbalance_m, c.unbalance_m);
         // The axes in the other order: the same cell, the same members.
         let swapped = Inputs(vec![("mu".into(), 0.3), ("speed_rpm".into(), 8000.0)]);
-        assert_eq!(p.member_scene(&scene, &swapped, 2), (a.clone(), da.clone()));
+        assert_eq!(p.member_scene(&scene, &swapped, 2), (a.clone(), da));
         let other = Inputs(vec![("mu".into(), 0.3), ("speed_rpm".into(), 9000.0)]);
         assert_ne!(
             p.member_scene(&scene, &other, 2).0.unbalance_m,
