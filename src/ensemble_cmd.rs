@@ -187,14 +187,24 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
                 .collect::<Vec<_>>()
                 .join(", ")
         };
+        // A crossing outside the range reads `<4000` (reached already at the lowest speed)
+        // or `>16000` (not reached), its interval's open ends `-`.
+        let ends = (
+            g.speeds_rpm.first().copied().unwrap_or(f64::NAN),
+            g.speeds_rpm.last().copied().unwrap_or(f64::NAN),
+        );
         let levels: Vec<String> = g
             .levels
             .iter()
             .map(|l| {
+                let at = match l.speed_rpm {
+                    Some(s) => format!("{s:.0}"),
+                    None if g.reached_below_range(l.level) => format!("<{:.0}", ends.0),
+                    None => format!(">{:.0}", ends.1),
+                };
                 format!(
-                    "P{:.0}% {} [{}, {}]",
+                    "P{:.0}% {at} [{}, {}]",
                     100.0 * l.level,
-                    fmt_speed(l.speed_rpm),
                     fmt_speed(l.speed_lo_rpm),
                     fmt_speed(l.speed_hi_rpm)
                 )
@@ -209,7 +219,15 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
     }
     let w = whirlmap_plot::probability::render_probability(&out)
         .map_err(|e| Failure::coded(4, format!("charts: {e}")))?;
-    outln!("  output           {} ({} charts)", out.display(), w.len());
+    if w.is_empty() {
+        outln!(
+            "  output           {} (no chart: Fig. 4 as probability is drawn over the friction \
+             coefficient, and the grid has no mu axis)",
+            out.display()
+        );
+    } else {
+        outln!("  output           {} ({} charts)", out.display(), w.len());
+    }
     Ok(Done::flagged_if(o.failed > 0))
 }
 

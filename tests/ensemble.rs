@@ -126,6 +126,61 @@ fn the_order_of_the_axes_does_not_change_a_cells_members() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Fig. 4 as probability is over the friction coefficient: with a further axis it is drawn for
+/// one slice, named in its title; without a `mu` axis there is none, and the command says so.
+#[test]
+fn the_probability_chart_is_one_slice_and_needs_a_mu_axis() {
+    let dir = temp_dir("ens-slice");
+    let spec = |name: &str, scene: &str, axes: &str| {
+        let text = format!(
+            r#"{{"name": "{name}", "duration_s": 0.05, "scene": {{{scene}}},
+                "axes": {{"speed_rpm": [4000, 8000], {axes}}},
+                "ensemble": {{"members": 2, "seed": 1,
+                  "unbalance_m": {{"uniform": {{"from": 0, "to": 5e-6}}}}}}}}"#
+        );
+        spec_file(&dir, name, &text)
+    };
+    let sliced = spec(
+        "sliced",
+        "",
+        r#""mu": [0.3, 0.4], "clearance_m": [1e-4, 1.5e-4]"#,
+    );
+    let o = whirlmap(&[
+        "ensemble",
+        s(&sliced),
+        "--out",
+        s(&dir.join("a")),
+        "--no-progress",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out(&o).contains("(2 charts)"), "{}", out(&o));
+    let svg = read(&dir.join("a/charts/fig4_probability.svg"));
+    assert!(
+        svg.contains("slice at clearance_m = 0.0001"),
+        "the title names the slice"
+    );
+    let no_mu = spec(
+        "nomu",
+        r#""mu_dynamic": 0.4"#,
+        r#""clearance_m": [1e-4, 1.5e-4]"#,
+    );
+    let o = whirlmap(&[
+        "ensemble",
+        s(&no_mu),
+        "--out",
+        s(&dir.join("b")),
+        "--no-progress",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        out(&o).contains("no chart: Fig. 4 as probability is drawn over the friction"),
+        "{}",
+        out(&o)
+    );
+    assert!(!dir.join("b/charts/fig4_probability.png").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn another_seed_draws_other_members() {
     let dir = temp_dir("seed");

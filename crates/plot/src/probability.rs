@@ -3,8 +3,9 @@
 //! lines with their intervals as error bars (beside the cells, capped where they end in the
 //! range), the band between the lowest and the highest level shaded, and every cell's
 //! P(whirl) as a dot shaded from white (0) to red (1), keyed in the legend.
-//! Groups are placed by their `mu` input; with further (non-speed) axes, all groups are
-//! drawn over each other.
+//! Groups are placed by their `mu` input. With further (non-speed) axes the chart is one
+//! slice, every further input at its value in the first group, and its title says which (as
+//! the sweep maps do); a grid without a `mu` axis has no chart.
 
 use crate::axes::CHART_SIZE;
 use crate::error::ChartError;
@@ -29,7 +30,41 @@ const BAND: RGBColor = RGBColor(214, 39, 40);
 
 struct ProbabilityFigure<'a> {
     contours: &'a ContoursFile,
+    /// The groups drawn: the slice of [`slice`].
+    groups: Vec<&'a ContourGroup>,
     title: String,
+}
+
+/// The groups of one slice of `contours`: every input other than the friction coefficient
+/// that takes more than one value fixed at its value in the first group; with the slice in
+/// words (`slice at clearance_m = 0.0001`) when there are such inputs. No groups when none
+/// has a friction coefficient (then there is no Fig. 4 to draw).
+fn slice(contours: &ContoursFile) -> (Vec<&ContourGroup>, Option<String>) {
+    let with_mu: Vec<&ContourGroup> = contours
+        .groups
+        .iter()
+        .filter(|g| mu_of(&g.inputs).is_some())
+        .collect();
+    let Some(first) = with_mu.first() else {
+        return (Vec::new(), None);
+    };
+    let fixed: Vec<(&String, f64)> = first
+        .inputs
+        .iter()
+        .filter(|(k, _)| !matches!(k.as_str(), "mu" | "mu_dynamic"))
+        .filter(|(k, v)| with_mu.iter().any(|g| g.inputs.get(*k) != Some(v)))
+        .map(|(k, v)| (k, *v))
+        .collect();
+    let groups = with_mu
+        .iter()
+        .copied()
+        .filter(|g| fixed.iter().all(|(k, v)| g.inputs.get(*k) == Some(v)))
+        .collect();
+    let note = (!fixed.is_empty()).then(|| {
+        let parts: Vec<String> = fixed.iter().map(|(k, v)| format!("{k} = {v}")).collect();
+        format!("slice at {}", parts.join(", "))
+    });
+    (groups, note)
 }
 
 fn mu_of(inputs: &std::collections::BTreeMap<String, f64>) -> Option<f64> {
@@ -42,10 +77,9 @@ fn mu_of(inputs: &std::collections::BTreeMap<String, f64>) -> Option<f64> {
 impl Figure for ProbabilityFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
         let mut groups: Vec<(f64, &ContourGroup)> = self
-            .contours
             .groups
             .iter()
-            .filter_map(|g| mu_of(&g.inputs).filter(|m| m.is_finite()).map(|m| (m, g)))
+            .filter_map(|g| mu_of(&g.inputs).filter(|m| m.is_finite()).map(|m| (m, *g)))
             .collect();
         groups.sort_by(|a, b| a.0.total_cmp(&b.0));
         let speeds: Vec<f64> = groups
@@ -104,15 +138,22 @@ impl Figure for ProbabilityFigure<'_> {
             }
         }
 
-        let n_levels = self.contours.groups.first().map_or(0, |g| g.levels.len());
-        // The band between the lowest and the highest level; where the highest is not
-        // reached in the range, the band runs to the top of the chart.
+        let n_levels = self.groups.first().map_or(0, |g| g.levels.len());
+        // The band between the lowest and the highest level; a level whose crossing lies
+        // beyond the range puts the band's edge at that end of the chart: the top where it
+        // is not reached, the bottom where it is reached already at the lowest speed. A
+        // friction coefficient whose lowest level is not reached has no band.
         if n_levels >= 2 {
+            let (bottom, top) = (s_lo - pad_s, s_hi + pad_s);
+            let edge = |g: &ContourGroup, l: &whirlmap_results::contours::LevelCrossing| {
+                l.speed_rpm
+                    .or_else(|| g.reached_below_range(l.level).then_some(bottom))
+            };
             let pts: Vec<(f64, f64, f64)> = groups
                 .iter()
                 .filter_map(|(m, g)| {
-                    let a = g.levels.first()?.speed_rpm?;
-                    let b = g.levels.last()?.speed_rpm.unwrap_or(s_hi + pad_s);
+                    let a = edge(g, g.levels.first()?)?;
+                    let b = edge(g, g.levels.last()?).unwrap_or(top);
                     Some((*m, a, b))
                 })
                 .collect();
@@ -171,7 +212,6 @@ impl Figure for ProbabilityFigure<'_> {
         // Legend, two rows: the levels; then the cells' dots with their key and the bars.
         let style = text_style(14.0);
         let levels = self
-            .contours
             .groups
             .first()
             .map(|g| g.levels.as_slice())
@@ -217,7 +257,7 @@ fn cell_dot<DB: DrawingBackend>(
 }
 
 /// Draws `charts/fig4_probability.{png,svg}` in `dir` if `dir/contours.json` exists;
-/// returns the files written (none without contours).
+/// returns the files written (none without contours, or without a friction axis in them).
 pub fn render_probability(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
     let path = dir.join(CONTOURS_FILE);
     let text = match std::fs::read_to_string(&path) {
@@ -230,17 +270,23 @@ pub fn render_probability(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
         line: e.line(),
         message: e.to_string(),
     })?;
+    let (groups, note) = slice(&contours);
+    if groups.is_empty() {
+        return Ok(Vec::new());
+    }
     let out = dir.join(whirlmap_results::files::CHARTS_DIR);
     std::fs::create_dir_all(&out).map_err(|cause| ChartError::Write {
         path: out.clone(),
         cause,
     })?;
+    let what = match note {
+        Some(n) => format!("{}, {n}", contours.name),
+        None => contours.name.clone(),
+    };
     let figure = ProbabilityFigure {
         contours: &contours,
-        title: format!(
-            "Fig. 4 as probability: critical whirl speed bands ({})",
-            contours.name
-        ),
+        groups,
+        title: format!("Fig. 4 as probability: critical whirl speed bands ({what})"),
     };
     let mut written = Vec::new();
     for ext in ["png", "svg"] {

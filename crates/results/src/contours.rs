@@ -39,6 +39,20 @@ pub struct ContourGroup {
     pub non_monotone: bool,
 }
 
+impl ContourGroup {
+    /// For a level without a crossing in the range (`speed_rpm` null): whether P(whirl) is at
+    /// or above it already at the lowest speed with a value, so that the crossing lies below
+    /// the range; false when P stays below the level (the crossing lies above the range, or
+    /// no cell has a value).
+    pub fn reached_below_range(&self, level: f64) -> bool {
+        self.p_whirl
+            .iter()
+            .flatten()
+            .find(|p| p.is_finite())
+            .is_some_and(|p| *p >= level)
+    }
+}
+
 /// The contents of `contours.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ContoursFile {
@@ -50,4 +64,28 @@ pub struct ContoursFile {
     pub confidence: f64,
     /// One group per combination of the non-speed inputs.
     pub groups: Vec<ContourGroup>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_level_out_of_range_is_placed_below_or_above_it() {
+        let g = |p: Vec<Option<f64>>| ContourGroup {
+            inputs: BTreeMap::new(),
+            speeds_rpm: (0..p.len()).map(|k| 4000.0 + 2000.0 * k as f64).collect(),
+            p_whirl: p,
+            levels: Vec::new(),
+            non_monotone: false,
+        };
+        // P 0.25 already at the lowest speed with a value (the first cell had none).
+        let rising = g(vec![None, Some(0.25), Some(0.5), Some(0.75)]);
+        assert!(rising.reached_below_range(0.1) && rising.reached_below_range(0.25));
+        assert!(
+            !rising.reached_below_range(0.9),
+            "never reached: above the range"
+        );
+        assert!(!g(vec![None, None]).reached_below_range(0.1));
+    }
 }
