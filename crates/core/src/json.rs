@@ -66,7 +66,16 @@ fn walk(given: &Value, shape: &Value, path: &str) -> Result<(), String> {
 /// expected f64 at line 1 column 23 ``.
 pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, serde_json::Error> {
     let mut de = serde_json::Deserializer::from_str(text);
-    let parsed: T = serde_path_to_error::deserialize(&mut de).map_err(with_path)?;
+    let parsed: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        // A whole file that is a list (`[]`) fails inside serde as a struct read by position
+        // ("invalid length 0, expected struct SweepSpec with 9 elements"): said plainly.
+        match serde_json::from_str::<Value>(text) {
+            Ok(Value::Array(_)) => <serde_json::Error as serde::de::Error>::custom(
+                "the top level must be a JSON object {\"name\": value, ...}, not a list",
+            ),
+            _ => with_path(e),
+        }
+    })?;
     de.end()?;
     let given: Value = serde_json::from_str(text)?;
     check_objects(&given, &parsed).map_err(<serde_json::Error as serde::de::Error>::custom)?;
@@ -106,6 +115,17 @@ pub fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Erro
 mod tests {
     use super::*;
     use crate::Scene;
+
+    #[test]
+    fn a_file_that_is_a_list_is_said_to_be_one() {
+        for text in ["[]", "[1000, 0.1]", "[{}]"] {
+            let m = from_str::<Scene>(text).unwrap_err().to_string();
+            assert!(
+                m.starts_with("the top level must be a JSON object"),
+                "{text}: {m}"
+            );
+        }
+    }
 
     #[test]
     fn a_number_out_of_range_and_a_list_too_long_name_their_field() {
