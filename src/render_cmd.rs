@@ -87,7 +87,15 @@ pub fn run(a: &RenderArgs) -> Result<(), RenderFailure> {
     let ensemble = a.dir.join(CONTOURS_FILE).is_file() && !a.dir.join(POINTS_FILE).is_file();
     let inputs = folder::reader_inputs(&a.dir);
     let checked = if ensemble {
-        Ok(folder::Checked::default())
+        // Said as for a sweep folder without a file list.
+        Ok(folder::Checked {
+            warnings: vec![format!(
+                "{} is an ensemble's folder, whose manifest lists no files: its {CONTOURS_FILE} \
+                 cannot be checked against the run that wrote it",
+                a.dir.display()
+            )],
+            ..Default::default()
+        })
     } else {
         folder::check_inputs(&a.dir, &inputs)
     };
