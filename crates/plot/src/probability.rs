@@ -87,7 +87,9 @@ impl Figure for ProbabilityFigure<'_> {
             .flat_map(|(_, g)| g.speeds_rpm.iter().copied())
             .filter(|s| s.is_finite())
             .collect();
-        let span = |v: &[f64]| {
+        // A single value gets a tenth of itself either side (at least `half`), not a unit:
+        // one friction coefficient of 0.25 spans 0.225-0.275, not -0.75-1.25.
+        let span = |v: &[f64], half: f64| {
             let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             if !lo.is_finite() {
@@ -95,12 +97,13 @@ impl Figure for ProbabilityFigure<'_> {
             } else if hi > lo {
                 (lo, hi)
             } else {
-                (lo - 1.0, lo + 1.0)
+                let h = (0.1 * lo.abs()).max(half);
+                (lo - h, lo + h)
             }
         };
-        let (s_lo, s_hi) = span(&speeds);
+        let (s_lo, s_hi) = span(&speeds, 100.0);
         let mus: Vec<f64> = groups.iter().map(|g| g.0).collect();
-        let (m_lo, m_hi) = span(&mus);
+        let (m_lo, m_hi) = span(&mus, 0.01);
         let (pad_m, pad_s) = (0.08 * (m_hi - m_lo), 0.05 * (s_hi - s_lo));
 
         let body = with_header(root, TITLE_BAND, &self.title, TITLE_FONT)?;
