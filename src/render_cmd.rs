@@ -139,5 +139,12 @@ pub fn run(a: &RenderArgs) -> Result<(), RenderFailure> {
     for p in &written {
         outln!("{}", p.display());
     }
+    if written.is_empty() && ensemble {
+        outln!(
+            "{}: no chart: Fig. 4 as probability is drawn over the friction coefficient, and \
+             the ensemble's grid has no mu axis",
+            a.dir.display()
+        );
+    }
     Ok(())
 }

@@ -178,6 +178,17 @@ fn the_probability_chart_is_one_slice_and_needs_a_mu_axis() {
         out(&o)
     );
     assert!(!dir.join("b/charts/fig4_probability.png").exists());
+    // render says the same, and removes a chart drawn there before as stale.
+    std::fs::create_dir_all(dir.join("b/charts")).unwrap();
+    std::fs::write(dir.join("b/charts/fig4_probability.png"), "old").unwrap();
+    let o = whirlmap(&["render", s(&dir.join("b"))]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        out(&o).contains("no chart: Fig. 4 as probability"),
+        "{}",
+        out(&o)
+    );
+    assert!(!dir.join("b/charts/fig4_probability.png").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -67,9 +67,12 @@ pub fn render_all(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
 /// data the run wrote but the folder no longer holds (orbit files left out of a repository)
 /// is kept rather than removed as stale.
 pub fn render_all_keeping(dir: &Path, keep: &[&str]) -> Result<Vec<PathBuf>, ChartError> {
-    // An ensemble's results: Fig. 4 with probability bands (docs/probability.md).
+    // An ensemble's results: Fig. 4 with probability bands (docs/probability.md); none for
+    // an ensemble without a friction axis, whose old chart, if any, is stale.
     let prob = crate::probability::render_probability(dir)?;
-    if !prob.is_empty() && !dir.join(POINTS_FILE).exists() {
+    let ensemble = dir.join(whirlmap_results::files::CONTOURS_FILE).is_file();
+    if ensemble && !dir.join(POINTS_FILE).exists() {
+        remove_stale_charts(&dir.join(CHARTS_DIR), &prob)?;
         return Ok(prob);
     }
     let rows = load_points(dir)?;
