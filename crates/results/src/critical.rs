@@ -347,10 +347,10 @@ impl Recheck {
     /// Records this re-check in `row`. One whose onset does not hold at the tighter preset
     /// ([`Recheck::holds`]) makes the row not converged (its onset is the search preset's
     /// only) and puts `NOT CONFIRMED` and the drops ([`Recheck::outcomes`]) in its note,
-    /// so that `critical.csv`, which has no re-check columns, says it too: at the head of the
-    /// note, or after the note of an undecided row, which starts with `UNDECIDED`. One that
-    /// holds only within the tolerance (`within_tol`) says so in the note, in the same place,
-    /// and leaves `converged` as it was.
+    /// so that `critical.csv`'s note says it too (beside its re-check columns): at the head
+    /// of the note, or after the note of an undecided row, which starts with `UNDECIDED`.
+    /// One that holds only within the tolerance (`within_tol`) says so in the note, in the
+    /// same place, and leaves `converged` as it was.
     pub fn apply_to(self, row: &mut CriticalRow) {
         let clause = if !self.holds() {
             row.converged = false;

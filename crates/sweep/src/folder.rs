@@ -498,18 +498,21 @@ pub fn release_previous(prev: Option<PathBuf>) -> Result<(), SweepError> {
     Ok(())
 }
 
-/// Whether the file at `rel` (`/`-separated, relative to a results folder) is one whirlmap
-/// writes: in a `charts/` folder only its charts ([`whirlmap_results::files::is_chart_file`]),
-/// in an `orbits/` folder only orbit and error files, in `probability/` (an ensemble's folder)
-/// only the names of [`OWNED`]; anywhere else, any file (the lists it is asked about hold
-/// only whirlmap's names).
+/// Whether the file at `rel` (`/`-separated, relative to a results folder) may be one
+/// whirlmap writes: directly in `charts/` or `probability/charts/` only its charts
+/// ([`whirlmap_results::files::is_chart_file`]), directly in `orbits/` only orbit and error
+/// files, directly in `probability/` (an ensemble's folder) only the names of [`OWNED`];
+/// nothing deeper in those folders; under `previous-run/`, and at the top level, any file
+/// (the top-level names a run lists or moves are [`OWNED`]'s).
 pub fn is_whirlmaps(rel: &str) -> bool {
-    let (parent, name) = rel.rsplit_once('/').unwrap_or(("", rel));
-    let sub = parent.rsplit('/').next().unwrap_or(parent);
-    match sub {
-        CHARTS_DIR => whirlmap_results::files::is_chart_file(name),
-        ORBITS_DIR => whirlmap_results::files::is_orbit_file(name),
-        _ if parent == PROBABILITY_DIR => OWNED.contains(&name),
+    use whirlmap_results::files::{is_chart_file, is_orbit_file};
+    let parts: Vec<&str> = rel.split('/').collect();
+    match parts.as_slice() {
+        [CHARTS_DIR, name] | [PROBABILITY_DIR, CHARTS_DIR, name] => is_chart_file(name),
+        [ORBITS_DIR, name] => is_orbit_file(name),
+        [PROBABILITY_DIR, PREVIOUS_DIR, ..] => true,
+        [PROBABILITY_DIR, name] => OWNED.contains(name),
+        [CHARTS_DIR | ORBITS_DIR | PROBABILITY_DIR, ..] => false,
         _ => true,
     }
 }
@@ -954,6 +957,9 @@ mod tests {
             "orbits/notes.txt",
             "probability/notes.md",
             "probability/charts/mine.svg",
+            "charts/old/classes.png",
+            "orbits/sub/00_8000rpm_mu0.100.json",
+            "probability/x/members.jsonl",
         ] {
             assert!(!is_whirlmaps(rel), "{rel}");
         }

@@ -456,8 +456,14 @@ pub fn merge(
                 let contours = dir.join(crate::ensemble::CONTOURS_FILE);
                 if contours.is_file() {
                     if let Ok(entries) = std::fs::read_dir(&dir) {
+                        // The ensemble's own files: a user's beside them is neither
+                        // checked nor copied.
                         let mut files: Vec<PathBuf> = entries
                             .flatten()
+                            .filter(|e| {
+                                let name = e.file_name().to_string_lossy().into_owned();
+                                folder::is_whirlmaps(&format!("{PROBABILITY_DIR}/{name}"))
+                            })
                             .map(|e| e.path())
                             .filter(|p| p.is_file())
                             .collect();
