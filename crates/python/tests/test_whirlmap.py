@@ -310,7 +310,7 @@ def test_a_sweep_spec_warns_of_the_scene_values_its_preset_replaces(tmp_path: Pa
         rows = whirlmap.sweep(replaced)
     path = tmp_path / "replaced.json"
     path.write_text(json.dumps({"name": "replaced", **replaced}))
-    with pytest.warns(RuntimeWarning, match="replaced.json: its fidelity sets the numerics"):
+    with pytest.warns(RuntimeWarning, match="replaced.json: fidelity draft sets the numerics"):
         assert whirlmap.sweep(path) == rows
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)

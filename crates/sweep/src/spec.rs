@@ -591,21 +591,34 @@ fn check_range(field: &str, from: f64, to: f64) -> Result<(), SpecError> {
     }
 }
 
-/// The scene values a spec's `fidelity` preset replaces: each key of
-/// [`Fidelity::KEYS`] that the spec's `scene` sets, as `(scene.solver.rtol, 1e-6)`, in the
-/// order of `KEYS`. Empty without a `fidelity` or when `spec` is not an object. The preset
-/// is applied to the scene after the file's values, so these have no effect; an axis, applied
-/// after the preset, still may vary them. Works on the spec's JSON (a sweep's or an
-/// ensemble's), because a parsed scene cannot tell a value written in the file from a default.
+/// The scene values a spec's `fidelity` preset replaces: each key of [`Fidelity::KEYS`] that
+/// the spec's `scene` sets to another value than the preset's, as `(scene.solver.rtol,
+/// 1e-6)`, in the order of `KEYS`. Empty without a valid `fidelity` or when `spec` is not an
+/// object. The preset is applied to the scene after the file's values, so these have no
+/// effect; an axis, applied after the preset, still may vary them. Works on the spec's JSON
+/// (a sweep's or an ensemble's), because a parsed scene cannot tell a value written in the
+/// file from a default.
 pub fn replaced_by_fidelity(spec: &Value) -> Vec<(String, String)> {
-    let (Some(Value::String(_)), Some(scene)) = (spec.get("fidelity"), spec.get("scene")) else {
+    let (Some(Value::String(name)), Some(scene)) = (spec.get("fidelity"), spec.get("scene")) else {
         return Vec::new();
     };
+    let Ok(preset) = Fidelity::parse(name) else {
+        return Vec::new();
+    };
+    // The preset's values, as the scene's JSON has them.
+    let applied = serde_json::to_value(preset.applied(&Scene::paper())).unwrap_or_default();
+    let at = |v: &Value, key: &str| key.split('.').try_fold(v, |v, part| v.get(part)).cloned();
     Fidelity::KEYS
         .iter()
         .filter_map(|key| {
-            let value = key.split('.').try_fold(scene, |v, part| v.get(part))?;
-            Some((format!("scene.{key}"), value.to_string()))
+            let given = at(scene, key)?;
+            let set = at(&applied, key);
+            // 1e-4 and 0.0001 are one number; `"rodas4"` one method.
+            let same = match (given.as_f64(), set.as_ref().and_then(Value::as_f64)) {
+                (Some(a), Some(b)) => a == b,
+                _ => Some(&given) == set.as_ref(),
+            };
+            (!same).then(|| (format!("scene.{key}"), given.to_string()))
         })
         .collect()
 }
@@ -1160,7 +1173,13 @@ mod tests {
         let mut v: Value = serde_json::from_str(GOOD).unwrap();
         // No preset: the file's rtol is used, nothing is replaced.
         assert!(replaced_by_fidelity(&v).is_empty());
+        // Nor with a name that is no preset (refused with the spec's own error).
+        v["fidelity"] = "fast".into();
+        assert!(replaced_by_fidelity(&v).is_empty());
         v["fidelity"] = "draft".into();
+        // The preset's own values are not replaced: draft's method and race tolerance scale.
+        v["scene"]["solver"]["method"] = "rodas4".into();
+        v["scene"]["solver"]["race_atol_scale"] = 1e3.into();
         v["scene"]["quasi_static_race"] = true.into();
         v["scene"]["solver"]["max_step_attempts"] = 40.into();
         let listed = replaced_by_fidelity(&v);

@@ -185,9 +185,11 @@ def _warn_spec_preset_overrides(spec_text: str, where: str) -> None:
     """Warn (``RuntimeWarning``) of each value of a sweep spec's ``scene`` that its
     ``fidelity`` preset replaces: the preset is applied after them, so they would otherwise
     vanish without a word. An axis is applied after the preset and may still set them."""
-    for key, value in _whirlmap.replaced_by_fidelity(spec_text):
+    replaced = _whirlmap.replaced_by_fidelity(spec_text)
+    preset = json.loads(spec_text).get("fidelity") if replaced else None
+    for key, value in replaced:
         warnings.warn(
-            f"{where}: its fidelity sets the numerics, so {key} = {value} has no effect"
+            f"{where}: fidelity {preset} sets the numerics, so {key} = {value} has no effect"
             " (leave out fidelity to choose them yourself, or give the value on an axis,"
             " which is applied after the preset)",
             RuntimeWarning,
