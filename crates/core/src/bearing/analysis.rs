@@ -367,7 +367,8 @@ fn cube_integral(a: f64, b: f64, qa: f64, qb: f64) -> f64 {
 
 /// The assumptions behind every number of a [`BearingReport`], to print beside them.
 pub fn assumptions() -> &'static str {
-    "Bearing: the pair of the scene's `bearing` section, with the values of the table above; \
+    "Bearing: the pair of the scene's `bearing` section, with the values listed under \
+\"The bearing\" above; \
 its defaults are two 71908 CD (15 deg contact angle) face to face, 5.5 mm balls on a 51 mm pitch \
 circle (paper Table 3), 22 balls a row and groove conformities 0.52/0.53 assumed (ISO 281 \
 rating basis; not in the catalogue tables), bearing steel E = 208 GPa, nu = 0.3.
