@@ -367,7 +367,7 @@ impl RunFolder {
     /// Moves the owned files in `present` into [`PREVIOUS_DIR`]. When an earlier overwrite
     /// was killed before its first records (the folder's own points hold no complete record),
     /// the files moved aside then are the ones worth keeping: they stay, and the current
-    /// ones are removed.
+    /// ones are removed; unless that move itself did not finish ([`keep_or_finish`]).
     fn move_aside(&mut self, present: &[&str]) -> Result<(), SweepError> {
         let prev = self.dir.join(PREVIOUS_DIR);
         let current_has_records = std::fs::read(self.dir.join(POINTS_FILE))
@@ -379,11 +379,12 @@ impl RunFolder {
             .filter(|n| *n != PREVIOUS_DIR)
             .collect();
         if prev.exists() && !current_has_records {
-            take_owned(&self.dir, &present, None)?;
+            keep_or_finish(&self.dir, &present)?;
         } else {
             remove_path(&prev)?;
             std::fs::create_dir(&prev).map_err(io_err(&prev))?;
             take_owned(&self.dir, &present, Some(&prev))?;
+            mark_moved(&prev)?;
         }
         sync_dir(&self.dir);
         self.previous = Some(prev);
@@ -465,7 +466,8 @@ impl RunFolder {
 /// another ensemble's, a study's) is moved into [`PREVIOUS_DIR`], so that what the command
 /// writes is not mixed with another run's files, and nothing is lost if it is killed. When
 /// [`PREVIOUS_DIR`] is there already, an earlier overwrite did not finish: what it moved aside
-/// is kept, and the files of that unfinished run are removed. Returns the folder to remove
+/// is kept, and the files of that unfinished run are removed ([`keep_or_finish`]: or, when
+/// that move itself stopped part way, the move is finished). Returns the folder to remove
 /// ([`release_previous`]) once the command's results are written; `None` when nothing of
 /// whirlmap's was there.
 pub fn move_owned_aside(dir: &Path) -> Result<Option<PathBuf>, SweepError> {
@@ -476,15 +478,43 @@ pub fn move_owned_aside(dir: &Path) -> Result<Option<PathBuf>, SweepError> {
         .collect();
     let prev = dir.join(PREVIOUS_DIR);
     if prev.symlink_metadata().is_ok() {
-        take_owned(dir, &present, None)?;
+        keep_or_finish(dir, &present)?;
     } else if present.is_empty() {
         return Ok(None);
     } else {
         std::fs::create_dir(&prev).map_err(io_err(&prev))?;
         take_owned(dir, &present, Some(&prev))?;
+        mark_moved(&prev)?;
     }
     sync_dir(dir);
     Ok(Some(prev))
+}
+
+/// The file in [`PREVIOUS_DIR`] that says the move into it finished.
+const MOVED_MARK: &str = ".moved";
+
+/// Marks `prev` as holding everything that was moved aside.
+fn mark_moved(prev: &Path) -> Result<(), SweepError> {
+    let mark = prev.join(MOVED_MARK);
+    std::fs::write(&mark, b"").map_err(io_err(&mark))?;
+    sync_dir(prev);
+    Ok(())
+}
+
+/// With [`PREVIOUS_DIR`] there from an earlier `--overwrite`, and the folder's own files
+/// (`present`) not worth keeping over it: when that overwrite's move finished (its mark is
+/// there), the folder's files are a killed newer run's and are removed; when it did not (a
+/// write error stopped it part way, or a build without the mark made it), they are the rest
+/// of the older run: the move is finished, a file already in [`PREVIOUS_DIR`] kept over the
+/// folder's own, so that nothing of the older run is lost.
+fn keep_or_finish(dir: &Path, present: &[&str]) -> Result<(), SweepError> {
+    let prev = dir.join(PREVIOUS_DIR);
+    if prev.join(MOVED_MARK).exists() {
+        take_owned(dir, present, None)
+    } else {
+        take_owned(dir, present, Some(&prev))?;
+        mark_moved(&prev)
+    }
 }
 
 /// Deletes what [`move_owned_aside`] moved aside, once the new results are written.
@@ -520,7 +550,8 @@ pub fn is_whirlmaps(rel: &str) -> bool {
 /// Moves into `to` (or, with `None`, removes) the entries `names` of the folder `from` that
 /// are whirlmap's, leaving a user's files in place: `charts/` and `orbits/` go file by file
 /// ([`is_whirlmaps`]), `probability/` (an ensemble's folder) entry by entry, each of them
-/// removed once empty; any other name goes whole. Absent names are skipped.
+/// removed once empty; any other name goes whole. Absent names are skipped; an entry whose
+/// name `to` already holds is removed, not moved over it.
 fn take_owned(from: &Path, names: &[&str], to: Option<&Path>) -> Result<(), SweepError> {
     for name in names {
         let src = from.join(name);
@@ -531,6 +562,9 @@ fn take_owned(from: &Path, names: &[&str], to: Option<&Path>) -> Result<(), Swee
         let by_entry = [CHARTS_DIR, ORBITS_DIR, PROBABILITY_DIR].contains(name);
         if !(meta.is_dir() && by_entry) {
             match &dest {
+                // Finishing a move that stopped part way: what is there already was moved
+                // first, and is kept.
+                Some(d) if d.symlink_metadata().is_ok() => remove_path(&src)?,
                 Some(d) => std::fs::rename(&src, d).map_err(io_err(&src))?,
                 None => remove_path(&src)?,
             }
@@ -937,6 +971,43 @@ pub fn relist_tree(dir: &Path, rel: &str) -> Result<(), SweepError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An overwrite whose move into previous-run/ stopped part way leaves the older run's
+    /// other files in the folder: the next overwrite finishes the move instead of deleting
+    /// them, and keeps what was moved first. Once a move has finished, the folder's files
+    /// are a killed newer run's and go.
+    #[test]
+    fn a_move_aside_that_stopped_part_way_is_finished_not_lost() {
+        let dir = std::env::temp_dir().join(format!("whirlmap-moved-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let prev = dir.join(PREVIOUS_DIR);
+        std::fs::create_dir_all(prev.join(CHARTS_DIR)).unwrap();
+        std::fs::create_dir_all(dir.join(CHARTS_DIR)).unwrap();
+        // Moved before the stop: the old records and one chart.
+        std::fs::write(prev.join(MEMBERS_FILE), "old members").unwrap();
+        std::fs::write(prev.join("charts/classes.png"), "old").unwrap();
+        // Left behind: the old contours and another chart; a same-named file is kept moved.
+        std::fs::write(dir.join(CONTOURS_FILE), "old contours").unwrap();
+        std::fs::write(dir.join("charts/fig4_probability.png"), "old").unwrap();
+        std::fs::write(dir.join(MEMBERS_FILE), "newer").unwrap();
+        let back = move_owned_aside(&dir).unwrap();
+        assert_eq!(back.as_deref(), Some(prev.as_path()));
+        let read = |p: &Path| std::fs::read_to_string(p).unwrap();
+        assert_eq!(read(&prev.join(MEMBERS_FILE)), "old members");
+        assert_eq!(read(&prev.join(CONTOURS_FILE)), "old contours");
+        assert_eq!(read(&prev.join("charts/fig4_probability.png")), "old");
+        assert_eq!(read(&prev.join("charts/classes.png")), "old");
+        assert!(prev.join(MOVED_MARK).exists());
+        assert!(!dir.join(MEMBERS_FILE).exists() && !dir.join(CHARTS_DIR).exists());
+        // Killed again before writing anything worth keeping: now the folder's files go.
+        std::fs::write(dir.join(MEMBERS_FILE), "newer still").unwrap();
+        move_owned_aside(&dir).unwrap();
+        assert!(!dir.join(MEMBERS_FILE).exists());
+        assert_eq!(read(&prev.join(MEMBERS_FILE)), "old members");
+        release_previous(back).unwrap();
+        assert!(!prev.exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn whirlmaps_files_are_told_from_a_users() {
