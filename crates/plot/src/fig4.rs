@@ -63,11 +63,12 @@ pub struct BandPoint {
 }
 
 /// The band ends of every group of `contours` that has a `mu` input and the three levels
-/// 0.1, 0.5, 0.9; groups without them are skipped.
+/// 0.1, 0.5, 0.9; groups without them are skipped. With further axes, those of one slice, as
+/// Fig. 4 as probability draws them.
 pub fn band_points(contours: &ContoursFile) -> Vec<BandPoint> {
-    let mut out: Vec<BandPoint> = contours
-        .groups
-        .iter()
+    let mut out: Vec<BandPoint> = crate::probability::slice(contours)
+        .0
+        .into_iter()
         .filter_map(|g| {
             let mu = *g.inputs.get("mu").or_else(|| g.inputs.get("mu_dynamic"))?;
             let lo = *g.speeds_rpm.first()?;

@@ -39,7 +39,7 @@ struct ProbabilityFigure<'a> {
 /// that takes more than one value fixed at its value in the first group; with the slice in
 /// words (`slice at clearance_m = 0.0001`) when there are such inputs. No groups when none
 /// has a friction coefficient (then there is no Fig. 4 to draw).
-fn slice(contours: &ContoursFile) -> (Vec<&ContourGroup>, Option<String>) {
+pub(crate) fn slice(contours: &ContoursFile) -> (Vec<&ContourGroup>, Option<String>) {
     let with_mu: Vec<&ContourGroup> = contours
         .groups
         .iter()

@@ -147,8 +147,12 @@ pub fn render_all_keeping(dir: &Path, keep: &[&str]) -> Result<Vec<PathBuf>, Cha
                 .iter()
                 .filter_map(|g| g.speeds_rpm.last().copied())
                 .fold(0.0, f64::max);
+            let slice = match crate::probability::slice(c).1 {
+                Some(n) => format!(", {n}"),
+                None => String::new(),
+            };
             format!(
-                "over release conditions ({} drops per cell, up to {} r/min)",
+                "over release conditions ({} drops per cell, up to {} r/min{slice})",
                 c.members,
                 format_quantity(top)
             )
