@@ -59,6 +59,10 @@ pub fn run(a: &MergeArgs) -> CmdResult {
             let critical = out.join(whirlmap_sweep::extras::CRITICAL_FILE);
             let undecided = critical.is_file() && crate::sweep_cmd::critical_line(&out, &critical);
             outln!("  output           {}", out.display());
+            // The bearing's worst cells, as the sweep prints them (empty without its results).
+            for line in whirlmap_sweep::results::bearing_report::worst_lines(&out) {
+                outln!("  {line}");
+            }
             if !o.charts.is_empty() {
                 outln!("  charts           {} files", o.charts.len());
             }
