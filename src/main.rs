@@ -438,17 +438,37 @@ fn fixed(x: f64, decimals: usize) -> String {
 }
 
 /// Says on standard error which `--set` values the preset `f` replaces (its
-/// [`whirlmap_core::Fidelity::KEYS`], or the whole `solver` section): the preset is applied
-/// after them, so they would otherwise vanish without a word.
+/// [`whirlmap_core::Fidelity::KEYS`], also inside a whole `solver` section): the preset is
+/// applied after them, so they would otherwise vanish without a word.
 pub(crate) fn warn_preset_overrides(f: whirlmap_core::Fidelity, sets: &[String]) {
     for s in sets {
-        let key = s.split_once('=').map_or(s.as_str(), |(k, _)| k).trim();
-        if key == "solver" || whirlmap_core::Fidelity::KEYS.contains(&key) {
+        let (key, value) = s.split_once('=').unwrap_or((s.as_str(), ""));
+        let key = key.trim();
+        if whirlmap_core::Fidelity::KEYS.contains(&key) {
             errln!(
                 "warning: --fidelity {} sets the numerics, so --set {s} has no effect (leave \
                  out --fidelity to choose them yourself)",
                 f.name()
             );
+        } else if key == "solver" {
+            // A whole section: the preset replaces its keys of the preset's, the rest stay.
+            let given = serde_json::from_str::<serde_json::Value>(value.trim()).ok();
+            let replaced: Vec<String> = given
+                .as_ref()
+                .and_then(|v| v.as_object())
+                .into_iter()
+                .flat_map(|o| o.keys())
+                .filter(|k| whirlmap_core::Fidelity::KEYS.contains(&format!("solver.{k}").as_str()))
+                .cloned()
+                .collect();
+            if !replaced.is_empty() {
+                errln!(
+                    "warning: --fidelity {} sets the numerics, so {} of --set {s} has no effect \
+                     (its other keys do; leave out --fidelity to choose them yourself)",
+                    f.name(),
+                    replaced.join(", ")
+                );
+            }
         }
     }
 }

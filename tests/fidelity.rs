@@ -78,6 +78,17 @@ fn a_preset_says_which_set_values_it_replaces() {
     let out = whirlmap(&json(&base, &["--set", "unbalance_m=1e-6"]));
     assert!(out.status.success());
     assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+    // A whole solver section: only the preset's keys in it are replaced, and named.
+    let out = whirlmap(&json(&base, &["--set", r#"solver={"max_events":100000}"#]));
+    assert!(out.status.success());
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+    let out = whirlmap(&json(
+        &base,
+        &["--set", r#"solver={"max_events":100000,"rtol":1e-6}"#],
+    ));
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("so rtol of --set solver="), "{err}");
     let kept: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_ne!(kept["scene_hash"], draft["scene_hash"]);
     let out = whirlmap(&base);

@@ -254,6 +254,14 @@ def test_a_preset_warns_of_the_overrides_it_replaces() -> None:
         warnings.simplefilter("error", RuntimeWarning)
         kept = whirlmap.drop(duration_s=0.02, fidelity="draft", unbalance_m=1e-6, series=False)
     assert kept.record["scene_hash"] != draft.record["scene_hash"]
+    # A whole solver dict: only the preset's keys in it are replaced, and named.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        whirlmap.drop(
+            duration_s=0.02, fidelity="draft", solver={"max_events": 100000}, series=False
+        )
+    with pytest.warns(RuntimeWarning, match="so rtol of solver="):
+        whirlmap.drop(duration_s=0.02, fidelity="draft", solver={"rtol": 1e-6}, series=False)
     with pytest.warns(RuntimeWarning, match="quasi_static_race=True has no effect"):
         whirlmap.critical(
             0.1, from_rpm=2000, to_rpm=3000, resolution_rpm=1000, duration_s=0.05,

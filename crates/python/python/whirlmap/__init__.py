@@ -167,18 +167,30 @@ def _fidelity(fidelity: Optional[str]) -> Optional[str]:
 def _warn_preset_overrides(fidelity: Optional[str], overrides: Dict[str, Any]) -> None:
     """Warns of each override a fidelity preset replaces: the preset is applied after the
     overrides and sets the numerics (``solver__rtol``, ``solver__method``, ... and
-    ``quasi_static_race``), so they would otherwise vanish without a word."""
+    ``quasi_static_race``, also inside a whole ``solver`` dict), so they would otherwise
+    vanish without a word."""
     if fidelity is None:
         return
     for key, value in overrides.items():
         dotted = key.replace("__", ".")
-        if dotted == "solver" or dotted in _whirlmap.PRESET_KEYS:
+        if dotted in _whirlmap.PRESET_KEYS:
             warnings.warn(
                 f"fidelity={fidelity!r} sets the numerics, so {key}={value!r} has no effect"
                 " (leave out fidelity to choose them yourself)",
                 RuntimeWarning,
                 stacklevel=3,
             )
+        elif dotted == "solver" and isinstance(value, Mapping):
+            # A whole section: the preset replaces its keys of the preset's, the rest stay.
+            replaced = [k for k in value if f"solver.{k}" in _whirlmap.PRESET_KEYS]
+            if replaced:
+                warnings.warn(
+                    f"fidelity={fidelity!r} sets the numerics, so {', '.join(replaced)} of"
+                    f" {key}={value!r} has no effect (its other keys do; leave out fidelity"
+                    " to choose them yourself)",
+                    RuntimeWarning,
+                    stacklevel=3,
+                )
 
 
 def _warn_spec_preset_overrides(spec_text: str, where: str) -> None:
