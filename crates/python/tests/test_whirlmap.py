@@ -119,6 +119,14 @@ def test_a_bad_value_names_the_field_value_and_range() -> None:
         whirlmap.drop(8000, 0.3, duration_s=-1)
     with pytest.raises(ValueError, match="solver.rtol"):
         whirlmap.drop(8000, 0.3, solver__rtol="tight")
+    # Not a number at all: named as any other bad value, not float()'s message.
+    for bad in ("abc", None, True, np.array([8000.0, 9000.0])):
+        with pytest.raises(ValueError, match=r"invalid duration_s = .*: allowed a number"):
+            whirlmap.drop(8000, 0.3, duration_s=bad)
+    with pytest.raises(ValueError, match=r"invalid speed_rpm = 'fast': allowed a number"):
+        whirlmap.drop("fast", 0.3)
+    with pytest.raises(ValueError, match=r"invalid mu = 'abc': allowed a number"):
+        whirlmap.critical("abc", from_rpm=3000, to_rpm=4000)
     with pytest.raises(ValueError, match='fidelity = "fast"'):
         whirlmap.drop(8000, 0.3, fidelity="fast")
 

@@ -164,6 +164,18 @@ def _fidelity(fidelity: Optional[str]) -> Optional[str]:
     return fidelity
 
 
+def _number(value: Any, name: str) -> float:
+    """``value`` as a float, or a ``ValueError`` naming ``name``: a string, ``None``, a
+    boolean or an array of more than one number is no number here (the engine checks the
+    range)."""
+    if isinstance(value, (bool, np.bool_)) or np.ndim(value) != 0:
+        raise ValueError(f"invalid {name} = {value!r}: allowed a number")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid {name} = {value!r}: allowed a number") from None
+
+
 def _warn_preset_overrides(fidelity: Optional[str], overrides: Dict[str, Any]) -> None:
     """Warns of each override a fidelity preset replaces: the preset is applied after the
     overrides and sets the numerics (``solver__rtol``, ``solver__method``, ... and
@@ -274,9 +286,9 @@ def drop(
         )
     _warn_preset_overrides(fidelity, overrides)
     record, scene, arrays, clearance_m = _whirlmap.drop(
-        None if speed_rpm is None else float(speed_rpm),
-        None if mu is None else float(mu),
-        float(duration_s),
+        None if speed_rpm is None else _number(speed_rpm, "speed_rpm"),
+        None if mu is None else _number(mu, "mu"),
+        _number(duration_s, "duration_s"),
         _fidelity(fidelity),
         int(series_points) if series else None,
         _overrides(overrides),
@@ -361,7 +373,12 @@ def critical(
             for a re-check), and no row is returned; the message says how many drops had
             run. An exception another signal handler raises stops it the same way.
     """
-    mus = [float(mu)] if np.isscalar(mu) else [float(m) for m in mu]  # type: ignore[union-attr]
+    if np.ndim(mu) == 0:
+        mus = [_number(mu, "mu")]
+    elif np.ndim(mu) == 1:
+        mus = [_number(m, "mu") for m in mu]  # type: ignore[union-attr]
+    else:
+        raise ValueError(f"invalid mu = {mu!r}: allowed a number or a list of numbers")
     # The search sets the speed and the friction coefficient of every drop itself.
     for key, by in (("speed_rpm", "from_rpm and to_rpm"), ("mu_dynamic", "mu")):
         if key in overrides:
@@ -372,11 +389,11 @@ def critical(
     _warn_preset_overrides(fidelity, overrides)
     text = _whirlmap.critical(
         mus,
-        float(from_rpm),
-        float(to_rpm),
-        float(resolution_rpm),
-        float(tol_rpm),
-        float(duration_s),
+        _number(from_rpm, "from_rpm"),
+        _number(to_rpm, "to_rpm"),
+        _number(resolution_rpm, "resolution_rpm"),
+        _number(tol_rpm, "tol_rpm"),
+        _number(duration_s, "duration_s"),
         _fidelity(fidelity),
         _overrides(overrides),
         _threads(threads),
