@@ -106,41 +106,13 @@ struct SceneArgs {
     schema: bool,
 }
 
-/// The paper's scene with every field a scene file accepts: the fields a scene may leave out
-/// (at their defaults) follow the rest.
-#[derive(serde::Serialize)]
-struct FullScene<'a> {
-    #[serde(flatten)]
-    scene: &'a Scene,
-    release_offset_m: [f64; 2],
-    release_velocity_m_s: [f64; 2],
-    race_speed_rad_s: f64,
-    quasi_static_race: bool,
-    stop_speed_rpm: Option<f64>,
-    thermal: Option<whirlmap_core::ThermalParams>,
-    bearing: Option<whirlmap_core::bearing::BearingPair>,
-}
-
 /// What `whirlmap scene` prints.
 fn scene_text(a: &SceneArgs) -> String {
     if a.schema {
         let schema = whirlmap_core::schema::scene_schema();
         return serde_json::to_string_pretty(&schema).expect("the schema serialises");
     }
-    let paper = Scene::paper();
-    let full = FullScene {
-        scene: &paper,
-        release_offset_m: paper.release_offset_m,
-        release_velocity_m_s: paper.release_velocity_m_s,
-        race_speed_rad_s: paper.race_speed_rad_s,
-        quasi_static_race: paper.quasi_static_race,
-        stop_speed_rpm: paper.stop_speed_rpm,
-        thermal: a.all.then(whirlmap_core::ThermalParams::default),
-        bearing: a
-            .all
-            .then(whirlmap_core::bearing::BearingPair::paper_71908_cd),
-    };
-    serde_json::to_string_pretty(&full).expect("scene serialises")
+    Scene::paper_every_field(a.all)
 }
 
 #[derive(Subcommand)]

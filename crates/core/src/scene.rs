@@ -405,7 +405,39 @@ fn is_zero2(v: &[f64; 2]) -> bool {
     is_zero(&v[0]) && is_zero(&v[1])
 }
 
+/// The paper's scene with every field a scene file accepts (see [`Scene::paper_every_field`]).
+#[derive(Serialize)]
+struct EveryField<'a> {
+    #[serde(flatten)]
+    scene: &'a Scene,
+    release_offset_m: [f64; 2],
+    release_velocity_m_s: [f64; 2],
+    race_speed_rad_s: f64,
+    quasi_static_race: bool,
+    stop_speed_rpm: Option<f64>,
+    thermal: Option<ThermalParams>,
+    bearing: Option<BearingPair>,
+}
+
 impl Scene {
+    /// The paper's scene as pretty JSON with every field a scene file accepts, as
+    /// `whirlmap scene` prints it: the fields a scene may leave out (at their defaults) follow
+    /// the rest; with `sections`, the optional thermal model and bearing analysis at their
+    /// defaults too (`null` otherwise: off).
+    pub fn paper_every_field(sections: bool) -> String {
+        let paper = Scene::paper();
+        let full = EveryField {
+            scene: &paper,
+            release_offset_m: paper.release_offset_m,
+            release_velocity_m_s: paper.release_velocity_m_s,
+            race_speed_rad_s: paper.race_speed_rad_s,
+            quasi_static_race: paper.quasi_static_race,
+            stop_speed_rpm: paper.stop_speed_rpm,
+            thermal: sections.then(ThermalParams::default),
+            bearing: sections.then(BearingPair::paper_71908_cd),
+        };
+        serde_json::to_string_pretty(&full).expect("a scene serialises")
+    }
     /// The bearing pair the analysis runs with, if the scene turns it on: the scene's
     /// `bearing`, with its lumped stiffness taken from the support law (k2, eq. 7) when the
     /// support exponent is Hertz's 1.5, so that the ball loads resolve to the force the

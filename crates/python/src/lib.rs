@@ -163,10 +163,12 @@ fn fidelity(name: Option<&str>) -> PyResult<Option<Fidelity>> {
         .transpose()
 }
 
-/// The default (paper) scene as JSON text: every key an override may name.
+/// The default (paper) scene as JSON text, every key an override may name, as
+/// `whirlmap scene --all` prints it (the thermal model and the bearing analysis at their
+/// defaults).
 #[pyfunction]
 fn default_scene() -> String {
-    serde_json::to_string(&Scene::paper()).expect("a scene serialises")
+    Scene::paper_every_field(true)
 }
 
 /// One drop, as `whirlmap drop` runs it: the paper's scene, the overrides, then `speed_rpm`

@@ -156,6 +156,11 @@ def test_default_scene_lists_the_override_keys() -> None:
     scene = whirlmap.default_scene()
     assert scene["speed_rpm"] == 8000
     assert "rtol" in scene["solver"]
+    # The keys a scene may leave out are listed too, the optional sections at their defaults.
+    for key in ("release_offset_m", "race_speed_rad_s", "quasi_static_race", "stop_speed_rpm"):
+        assert key in scene, key
+    assert isinstance(scene["thermal"], dict) and scene["thermal"], scene["thermal"]
+    assert scene["bearing"]["balls_per_row"] == 22
 
 
 def test_critical_rows() -> None:

@@ -225,7 +225,8 @@ def default_scene() -> Dict[str, Any]:
     """The default (paper) scene as a dict: every key a scene override may name.
 
     Returns:
-        The JSON of ``whirlmap scene``, parsed.
+        The JSON of ``whirlmap scene --all``, parsed: the ``thermal`` and ``bearing``
+        sections at their defaults, though a drop runs without them unless they are given.
     """
     return json.loads(_whirlmap.default_scene())
 
