@@ -2,7 +2,7 @@
 the clearance circle (the paper's Fig. 3 view), with the contact force beneath.
 
     pip install ./crates/python matplotlib
-    python examples/python/orbit.py [--speed-rpm 8000] [--mu 0.3] [--out orbit.png]
+    python examples/python/orbit.py [--speed-rpm 8000] [--mu 0.4] [--out orbit.png]
 """
 
 from __future__ import annotations
@@ -20,11 +20,11 @@ import whirlmap  # noqa: E402
 
 def main() -> None:
     """Parse the options, run the drop and write the chart."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--speed-rpm", type=float, default=8000.0)
-    ap.add_argument("--mu", type=float, default=0.4)
-    ap.add_argument("--duration-s", type=float, default=0.5)
-    ap.add_argument("--out", default="orbit.png")
+    ap = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
+    ap.add_argument("--speed-rpm", type=float, default=8000.0, help="release speed (r/min)")
+    ap.add_argument("--mu", type=float, default=0.4, help="dynamic friction coefficient")
+    ap.add_argument("--duration-s", type=float, default=0.5, help="simulated time (s)")
+    ap.add_argument("--out", default="orbit.png", help="the chart's file (PNG)")
     a = ap.parse_args()
 
     d = whirlmap.drop(a.speed_rpm, a.mu, duration_s=a.duration_s)

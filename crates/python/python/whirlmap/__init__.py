@@ -303,7 +303,7 @@ def drop(
 
 
 def critical(
-    mu: Union[float, Sequence[float]],
+    mu: Union[float, Sequence[float], "np.ndarray[Any, Any]"],
     *,
     from_rpm: float = 1000.0,
     to_rpm: float = 30000.0,
