@@ -466,8 +466,8 @@ impl RunFolder {
 /// another ensemble's, a study's) is moved into [`PREVIOUS_DIR`], so that what the command
 /// writes is not mixed with another run's files, and nothing is lost if it is killed. When
 /// [`PREVIOUS_DIR`] is there already, an earlier overwrite did not finish: what it moved aside
-/// is kept, and the files of that unfinished run are removed ([`keep_or_finish`]: or, when
-/// that move itself stopped part way, the move is finished). Returns the folder to remove
+/// is kept, and the files of that unfinished run are removed (or, when that move itself
+/// stopped part way, the move is finished). Returns the folder to remove
 /// ([`release_previous`]) once the command's results are written; `None` when nothing of
 /// whirlmap's was there.
 pub fn move_owned_aside(dir: &Path) -> Result<Option<PathBuf>, SweepError> {
