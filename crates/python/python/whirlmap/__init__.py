@@ -285,7 +285,6 @@ def drop(
         raise ValueError(
             f"invalid series_points = {series_points!r}: allowed a whole number in [1, 1e7]"
         )
-    _warn_preset_overrides(fidelity, overrides)
     record, scene, arrays, clearance_m = _whirlmap.drop(
         None if speed_rpm is None else _number(speed_rpm, "speed_rpm"),
         None if mu is None else _number(mu, "mu"),
@@ -294,6 +293,8 @@ def drop(
         int(series_points) if series else None,
         _overrides(overrides),
     )
+    # After the drop: a call refused for a bad value says only that (a drop takes a second).
+    _warn_preset_overrides(fidelity, overrides)
     return DropResult(
         record=json.loads(record),
         series=None if arrays is None else {k: arrays[k] for k in SERIES_NAMES},
@@ -491,6 +492,8 @@ def sweep(
             message says how many points had run. An exception another signal handler
             raises stops it the same way.
     """
+    if flat not in (True, False):
+        raise ValueError(f"invalid flat = {flat!r}: allowed True or False")
     if isinstance(spec, Mapping):
         spec_dict = dict(spec)
         spec_dict.setdefault("name", "python")
