@@ -221,9 +221,9 @@ pub fn run_ensemble_cmd(args: &EnsembleCmdArgs) -> CmdResult {
         .map_err(|e| Failure::coded(4, format!("charts: {e}")))?;
     if w.is_empty() {
         outln!(
-            "  output           {} (no chart: Fig. 4 as probability is drawn over the friction \
-             coefficient, and the grid has no mu axis)",
-            out.display()
+            "  output           {} ({})",
+            out.display(),
+            whirlmap_plot::probability::NO_MU_AXIS
         );
     } else {
         outln!("  output           {} ({} charts)", out.display(), w.len());

@@ -141,9 +141,9 @@ pub fn run(a: &RenderArgs) -> Result<(), RenderFailure> {
     }
     if written.is_empty() && ensemble {
         outln!(
-            "{}: no chart: Fig. 4 as probability is drawn over the friction coefficient, and \
-             the ensemble's grid has no mu axis",
-            a.dir.display()
+            "{}: {}",
+            a.dir.display(),
+            whirlmap_plot::probability::NO_MU_AXIS
         );
     }
     Ok(())

@@ -73,7 +73,8 @@ pub fn band_points(contours: &ContoursFile) -> Vec<BandPoint> {
             let mu = *g.inputs.get("mu").or_else(|| g.inputs.get("mu_dynamic"))?;
             let lo = *g.speeds_rpm.first()?;
             let hi = *g.speeds_rpm.last()?;
-            let p0 = g.p_whirl.iter().flatten().next().copied()?;
+            // A group without a cell that finished has no band.
+            g.p_whirl.iter().flatten().next()?;
             let mut p = [0.0; 3];
             let mut reached = [false; 3];
             for (k, level) in [0.1, 0.5, 0.9].into_iter().enumerate() {
@@ -81,7 +82,7 @@ pub fn band_points(contours: &ContoursFile) -> Vec<BandPoint> {
                 (p[k], reached[k]) = match c.speed_rpm {
                     Some(s) => (s, true),
                     // Reached already at the lowest speed, or never in the range.
-                    None if p0 >= level => (lo, true),
+                    None if g.reached_below_range(level) => (lo, true),
                     None => (hi, false),
                 };
             }

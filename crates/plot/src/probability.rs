@@ -259,6 +259,12 @@ fn cell_dot<DB: DrawingBackend>(
     area.draw(&Circle::new(at, 5, RGBColor(150, 150, 150).stroke_width(1)))
 }
 
+/// Why an ensemble has no Fig. 4 as probability ([`render_probability`] draws none): the
+/// commands that run or redraw it say this.
+pub const NO_MU_AXIS: &str =
+    "no chart: Fig. 4 as probability is drawn over the friction coefficient, and the \
+     ensemble's grid has no mu axis";
+
 /// Draws `charts/fig4_probability.{png,svg}` in `dir` if `dir/contours.json` exists;
 /// returns the files written (none without contours, or without a friction axis in them).
 pub fn render_probability(dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
