@@ -21,7 +21,7 @@ impl DropSystem {
     /// (eq. 17's H_s, the dampers' power, the drag's M |omega_b|) and the two angles
     /// (theta' = omega). Only the unbalance terms are left out then.
     #[inline]
-    pub(super) fn stiff_jacobian_at(&self, y: &[f64; N]) -> StiffJacobian {
+    pub(super) fn fill_stiff_jacobian_at(&self, y: &[f64; N], sj: &mut StiffJacobian) {
         use ix::*;
         // Blocks of the stiff set: rotor position 0..2, race position 2..4, rotor velocity
         // 4..6, race velocity 6..8, then the rotor's (8) and the race's (9) spin.
@@ -31,7 +31,7 @@ impl DropSystem {
         const VB: usize = 6;
         const SR: usize = 8;
         const SB: usize = 9;
-        let mut sj = StiffJacobian::over(&[XR, YR, XB, YB, VXR, VYR, VXB, VYB, WR, WB]);
+        sj.reset_over(&[XR, YR, XB, YB, VXR, VYR, VXB, VYB, WR, WB]);
         // The four positions' rows are exactly q' = v (eqs. 1-6): the stepper eliminates them.
         sj.kinematic = 4;
         // The energy integrals' rows (their powers over the same components), then the two
@@ -292,7 +292,6 @@ impl DropSystem {
         }
         // The accumulators' rows, for the method that needs them.
         sj.quad_len = if self.exact_jacobian { 5 } else { 0 };
-        sj
     }
 
     /// The Palmgren drag's torque and slopes at `y` (eqs. 11-13): `None` without drag.

@@ -209,9 +209,16 @@ impl OdeSystem<N> for DropSystem {
         self.with_forces(y, |f| self.guards_of(f, g))
     }
 
-    /// See `DropSystem::stiff_jacobian_at` (`jacobian.rs`).
+    /// See `DropSystem::fill_stiff_jacobian_at` (`jacobian.rs`).
     fn stiff_jacobian(&self, _t: f64, y: &[f64; N]) -> Option<StiffJacobian> {
-        Some(self.stiff_jacobian_at(y))
+        let mut sj = StiffJacobian::over(&[]);
+        self.fill_stiff_jacobian_at(y, &mut sj);
+        Some(sj)
+    }
+
+    /// See `DropSystem::fill_stiff_jacobian_at` (`jacobian.rs`).
+    fn fill_stiff_jacobian(&self, _t: f64, y: &[f64; N], out: &mut StiffJacobian) {
+        self.fill_stiff_jacobian_at(y, out);
     }
 
     /// In free flight with `solver.free_flight_gap_bound`: the larger of the fixed cap and a

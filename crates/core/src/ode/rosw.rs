@@ -124,8 +124,14 @@ impl Lu {
                 // block by block (the general `reduced` entry by entry costs 3x more).
                 let jac = &self.j.jac;
                 let hg2 = hg * hg;
+                // Written in place: the factors are large enough that moving them costs.
+                if !matches!(self.factors, Factors::Six(..)) {
+                    self.factors = Factors::Six(Matrix6::zeros(), [0; 6]);
+                }
+                let Factors::Six(a, piv) = &mut self.factors else {
+                    unreachable!("set just above")
+                };
                 // The same operations in the same order as `reduced`, so the same bits.
-                let mut a = Matrix6::<f64>::zeros();
                 for b in 0..6 {
                     for r in 0..6 {
                         a[(r, b)] = -hg * jac[(4 + r, 4 + b)];
@@ -139,8 +145,9 @@ impl Lu {
                 for d in 0..6 {
                     a[(d, d)] += 1.0;
                 }
-                let (piv, ok) = lu6(&mut a);
-                (Factors::Six(a, piv), ok)
+                let (p, ok) = lu6(a);
+                *piv = p;
+                return ok;
             }
             _ => {
                 let lu = DMatrix::from_fn(m, m, |a, b| self.reduced(a, b)).lu();
@@ -458,9 +465,7 @@ where
     S: OdeSystem<N>,
     A: Fn(&mut StepCore<N>, &Lu, &[f64; N], &S, f64, &[f64; N], f64) -> ([f64; N], f64),
 {
-    lu.j = sys
-        .stiff_jacobian(t, y)
-        .unwrap_or_else(|| StiffJacobian::over(&[]));
+    sys.fill_stiff_jacobian(t, y, &mut lu.j);
     if !method.quadratures {
         lu.j.quad_len = 0;
     }

@@ -81,6 +81,18 @@ impl StiffJacobian {
         s.idx[..idx.len()].copy_from_slice(idx);
         s
     }
+
+    /// Makes `self` what [`StiffJacobian::over`] returns, in place.
+    pub fn reset_over(&mut self, idx: &[usize]) {
+        self.idx = [0; MAX_STIFF];
+        self.idx[..idx.len()].copy_from_slice(idx);
+        self.len = idx.len();
+        self.jac = JacobianMatrix::zeros();
+        self.kinematic = 0;
+        self.quad_idx = [0; MAX_QUAD];
+        self.quad_len = 0;
+        self.quad = QuadratureRows::zeros();
+    }
 }
 
 /// A first-order system `y' = f(t, y)` with a fixed-size state and mode guards.
@@ -114,6 +126,15 @@ pub trait OdeSystem<const N: usize> {
     /// matrix, which turns [`super::Ros34pw2`] into an explicit 3rd-order Runge-Kutta method.
     fn stiff_jacobian(&self, _t: f64, _y: &[f64; N]) -> Option<StiffJacobian> {
         None
+    }
+
+    /// [`OdeSystem::stiff_jacobian`] written into `out` (the empty matrix for `None`): the
+    /// steppers' way in, which a system overrides to build the matrix in place rather than
+    /// return it (it is large enough that moving it costs).
+    fn fill_stiff_jacobian(&self, t: f64, y: &[f64; N], out: &mut StiffJacobian) {
+        *out = self
+            .stiff_jacobian(t, y)
+            .unwrap_or_else(|| StiffJacobian::over(&[]));
     }
 
     /// The absolute tolerances of a step from `(t, y)`, when the system widens some
