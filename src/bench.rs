@@ -74,7 +74,7 @@ struct Case {
 /// ratio to the baseline (the first row) and to the peer, and the work counts.
 pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
     let reps = a.reps;
-    let cases: [Case; 14] = [
+    let cases: [Case; 17] = [
         Case {
             name: "pendulum 1 s, standard (baseline)",
             speed_rpm: 8000.0,
@@ -113,6 +113,26 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
                 Fidelity::Reference.apply(s);
                 s.solver.rtol = 1e-5;
             },
+        },
+        // RODAS4 then BDF, and the BDF alone, with `standard`'s other numerics
+        // (docs/performance.md#rodas4-then-bdf).
+        Case {
+            name: "pendulum 1 s, rodas4_bdf",
+            speed_rpm: 8000.0,
+            mu: 0.1,
+            edit: |s| s.solver.method = whirlmap_core::Method::Rodas4Bdf,
+        },
+        Case {
+            name: "whirl, rodas4_bdf",
+            speed_rpm: 8000.0,
+            mu: 0.4,
+            edit: |s| s.solver.method = whirlmap_core::Method::Rodas4Bdf,
+        },
+        Case {
+            name: "pendulum 1 s, bdf alone",
+            speed_rpm: 8000.0,
+            mu: 0.1,
+            edit: |s| s.solver.method = whirlmap_core::Method::Bdf,
         },
         Case {
             name: "pendulum 1 s, radial-only damper",

@@ -7,7 +7,7 @@ use std::ops::ControlFlow;
 use whirlmap_core::ode::{Observer, StepView};
 use whirlmap_core::*;
 struct Rec(
-    Vec<(f64, f64, bool, i32)>,
+    Vec<(f64, f64, bool, i32, u64)>,
     model::ModelEvals,
     Vec<(f64, f64, f64)>,
 );
@@ -23,7 +23,7 @@ impl Observer<model::DropSystem, { model::N }> for Rec {
             model::Slip::Sticking => 0,
             model::Slip::Slipping(x) => x as i32,
         };
-        self.0.push((s.dense.t0(), s.dense.t1(), m.contact, sl));
+        self.0.push((s.dense.t0(), s.dense.t1(), m.contact, sl, sys.model_evals().computed));
         if !m.contact {
             use whirlmap_core::ode::OdeSystem;
             let cap = sys.max_step_at(s.dense.t0(), &s.dense.y0());
@@ -51,6 +51,16 @@ fn main() {
                     s.solver.method = scene::Method::Ros34pw2
                 }
             }
+            "bdf" => {
+                if v == "true" {
+                    s.solver.method = scene::Method::Bdf
+                }
+            }
+            "hyb" => {
+                if v == "true" {
+                    s.solver.method = scene::Method::Rodas4Bdf
+                }
+            }
             "race" => s.solver.race_atol_scale = v.parse().unwrap(),
             "mu" => s.mu_dynamic = v.parse().unwrap(),
             "rpm" => s.speed_rpm = v.parse().unwrap(),
@@ -69,8 +79,9 @@ fn main() {
     .unwrap();
     println!("{:?} stop: {:?}", r.stats, r.stop_reason);
     println!("model evaluations: {:?}", rec.1);
-    let mut w = [[0usize; 4]; 20];
-    for &(t0, _t1, c, sl) in &rec.0 {
+    let mut w = [[0usize; 5]; 20];
+    let mut prev = 0u64;
+    for &(t0, _t1, c, sl, ev) in &rec.0 {
         let b = ((t0 / 0.05) as usize).min(19);
         let k = if !c {
             0
@@ -81,6 +92,8 @@ fn main() {
         };
         w[b][k] += 1;
         w[b][3] += 1;
+        w[b][4] += (ev - prev) as usize;
+        prev = ev;
     }
     let capped = rec.2.iter().filter(|r| r.1 >= 0.999 * r.2).count();
     let hmean = rec.2.iter().map(|r| r.1).sum::<f64>() / rec.2.len().max(1) as f64;
@@ -90,15 +103,16 @@ fn main() {
         capped,
         hmean
     );
-    println!("window  free  stick  slip  total");
+    println!("window  free  stick  slip  total  evals/step");
     for (i, r) in w.iter().enumerate() {
         println!(
-            "{:>4} ms {:>6} {:>6} {:>6} {:>6}",
+            "{:>4} ms {:>6} {:>6} {:>6} {:>6} {:>6.2}",
             i * 50,
             r[0],
             r[1],
             r[2],
-            r[3]
+            r[3],
+            r[4] as f64 / r[3].max(1) as f64
         );
     }
 }

@@ -503,6 +503,8 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
         Method::Rodas4 => run_with(scene, opts, extra, sys, Rodas4::new(ctl)),
         Method::Rodas5p => run_with(scene, opts, extra, sys, Rodas5p::new(ctl)),
         Method::Radau5 => run_with(scene, opts, extra, sys, crate::ode::Radau5::new(ctl)),
+        Method::Bdf => run_with(scene, opts, extra, sys, crate::ode::Bdf::new(ctl)),
+        Method::Rodas4Bdf => run_with(scene, opts, extra, sys, crate::ode::Rodas4Bdf::new(ctl)),
     }
 }
 

@@ -55,6 +55,14 @@ pub enum Method {
     /// RADAU5, the 3-stage Radau IIA collocation method of order 5 (Hairer and Wanner) on
     /// the full Jacobian, with a simplified Newton iteration (`ode/radau5.rs`).
     Radau5,
+    /// BDF, the backward differentiation formulas of orders 1-5 with variable order and
+    /// quasi-constant step size (Shampine and Reichelt's scheme), on the full Jacobian with
+    /// Newton's iteration from the Jacobian at each step's prediction (`ode/bdf.rs`). Alone
+    /// it restarts at order 1 after every mode switch.
+    Bdf,
+    /// RODAS4 after every mode switch, the BDF once the contact has carried for 12 steps and
+    /// 2 ms (`ode/rodas_bdf.rs`): RODAS4 takes the impacts, the BDF the rolling and the whirl.
+    Rodas4Bdf,
 }
 
 impl Method {
@@ -62,7 +70,10 @@ impl Method {
     /// Jacobian (every term: the energy integrals' rows, the sticking constraint's slopes, the
     /// drag's), rather than a W-method's stiff approximation or none.
     pub fn needs_exact_jacobian(self) -> bool {
-        matches!(self, Method::Rodas4 | Method::Rodas5p | Method::Radau5)
+        matches!(
+            self,
+            Method::Rodas4 | Method::Rodas5p | Method::Radau5 | Method::Bdf | Method::Rodas4Bdf
+        )
     }
 }
 
@@ -116,7 +127,10 @@ pub struct SolverSettings {
     /// `dop853` the independent reference of `whirlmap accuracy`; `rodas5p`, the 5th-order
     /// Rosenbrock method on RODAS4's Jacobian, for errors below about 1e-5 (docs/accuracy.md);
     /// `radau5`, the 5th-order Radau IIA collocation method on the same Jacobian, about half
-    /// of RODAS4's steps on a pendulum drop at a higher cost per step (docs/performance.md).
+    /// of RODAS4's steps on a pendulum drop at a higher cost per step (docs/performance.md);
+    /// `bdf`, the variable-order backward differentiation formulas; `rodas4_bdf`, RODAS4
+    /// after each mode switch and the BDF once the contact has run smoothly
+    /// (docs/model.md#integrator).
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a

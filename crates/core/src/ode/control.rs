@@ -72,6 +72,7 @@ impl<const N: usize> StepCore<N> {
                 terms,
                 r: [[0.0; N]; 8],
                 y1: [0.0; N],
+                y0: [0.0; N],
             },
         }
     }

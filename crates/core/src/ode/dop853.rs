@@ -321,6 +321,7 @@ impl<const N: usize> Dop853<N> {
             terms: 8,
             r,
             y1: *y_new,
+            y0: *y,
         };
         self.k1 = k[S];
         self.core.stats.steps += 1;

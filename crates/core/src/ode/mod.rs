@@ -7,6 +7,7 @@
 //! crosses to zero or below; it then returns *why* it stopped as a [`Stop`] and the caller
 //! switches mode and calls it again (the step restarts cleanly, without the FSAL stage).
 
+mod bdf;
 mod control;
 mod dop853;
 mod dopri5;
@@ -15,12 +16,14 @@ mod hybrid;
 mod integrate;
 mod radau5;
 mod rodas;
+mod rodas_bdf;
 mod rodas5p;
 mod rosw;
 mod step;
 mod stepper;
 mod system;
 
+pub use bdf::Bdf;
 pub use control::StepCore;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;
@@ -29,6 +32,7 @@ pub use hybrid::{run_hybrid, Finish, Hybrid, HybridObserver, JumpRules};
 pub use integrate::{integrate, NoObserver, Observer, StepView, Stop};
 pub use radau5::Radau5;
 pub use rodas::Rodas4;
+pub use rodas_bdf::Rodas4Bdf;
 pub use rodas5p::Rodas5p;
 pub use rosw::Ros34pw2;
 pub use step::{Dense, Stats, StepControl};

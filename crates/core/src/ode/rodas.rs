@@ -89,7 +89,8 @@ const CC: [[f64; 5]; 6] = [
 #[derive(Debug, Clone)]
 pub struct Rodas4<const N: usize> {
     core: StepCore<N>,
-    f0: [f64; N],
+    /// The derivative at the last accepted step's end (the next step's start).
+    pub(super) f0: [f64; N],
     lu: Lu,
 }
 

@@ -48,12 +48,21 @@ pub struct Dense<const N: usize> {
     pub(super) t0: f64,
     pub(super) h: f64,
     pub(super) t_end: f64,
-    /// Number of coefficient vectors in use: 5 (DOPRI5, the Rosenbrock methods) or 8 (DOP853).
+    /// Number of coefficient vectors in use: 5 (DOPRI5, the Rosenbrock methods) or 8 (DOP853)
+    /// in the nested form; or [`BACKWARD`] `+ k` for the BDF stepper's polynomial of degree
+    /// `k` through the step's end and the `k` solution values before it at spacing `h`, held
+    /// as the backward differences `r[j] = nabla^j y(t0 + h)`.
     pub(super) terms: usize,
     pub(super) r: [[f64; N]; 8],
     /// The step's end state, kept exactly (not re-summed from `r`).
     pub(super) y1: [f64; N],
+    /// The step's start state, kept exactly for the backward form (the nested form has it in
+    /// `r[0]`).
+    pub(super) y0: [f64; N],
 }
+
+/// [`Dense::terms`] at and above this value: the backward-difference form of the BDF stepper.
+pub(super) const BACKWARD: usize = 16;
 
 impl<const N: usize> Dense<N> {
     /// Start of the step (s).
@@ -67,10 +76,23 @@ impl<const N: usize> Dense<N> {
     /// State at `t` (meant for `t` in `[t0, t1]`).
     #[inline]
     pub fn eval(&self, t: f64) -> [f64; N] {
-        let th = (t - self.t0) / self.h;
-        let th1 = 1.0 - th;
         let mut y = [0.0; N];
         let r = &self.r;
+        if self.terms >= BACKWARD {
+            // y = D0 + s (D1 + (s + 1)/2 (D2 + (s + 2)/3 (D3 + ...))), s = (t - t_end)/h.
+            let k = self.terms - BACKWARD;
+            let s = (t - (self.t0 + self.h)) / self.h;
+            y = r[k];
+            for j in (0..k).rev() {
+                let w = (s + j as f64) / (j as f64 + 1.0);
+                for i in 0..N {
+                    y[i] = r[j][i] + w * y[i];
+                }
+            }
+            return y;
+        }
+        let th = (t - self.t0) / self.h;
+        let th1 = 1.0 - th;
         if self.terms == 5 {
             for i in 0..N {
                 y[i] = r[0][i] + th * (r[1][i] + th1 * (r[2][i] + th * (r[3][i] + th1 * r[4][i])));
@@ -85,7 +107,11 @@ impl<const N: usize> Dense<N> {
     }
     /// State at the start of the step.
     pub fn y0(&self) -> [f64; N] {
-        self.r[0]
+        if self.terms >= BACKWARD {
+            self.y0
+        } else {
+            self.r[0]
+        }
     }
     /// State at the end of the (possibly truncated) step.
     pub fn y1(&self) -> [f64; N] {

@@ -1,0 +1,574 @@
+//! BDF: the backward differentiation formulas of orders 1 to 5 with variable order and
+//! quasi-constant step size, on the stiff Jacobian with a Newton iteration.
+//!
+//! The scheme is Shampine and Reichelt's (`ode15s`; L. F. Shampine, M. W. Reichelt, "The
+//! MATLAB ODE Suite", SIAM J. Sci. Comput. 18, 1997) without its NDF modification, as
+//! SciPy's `BDF` has it; the formulas and their stability are in E. Hairer, G. Wanner,
+//! "Solving ODEs II", Sec. III.1 and V.1. The solution is carried as the backward differences
+//! `D_j = nabla^j y_n` of the last `k + 1` solution values at an equal spacing `h`; a step of
+//! another size first re-interpolates them to the new spacing. A step of order `k` solves
+//!
+//! `y_{n+1} - c f(y_{n+1}) = y_pred - psi`, `c = h / gamma_k`,
+//!
+//! with `y_pred = sum_{j<=k} D_j`, `psi = sum_{j=1..k} gamma_j D_j / gamma_k` and
+//! `gamma_k = sum_{j=1..k} 1/j`, by Newton's iteration on `I - c J` from `y_pred`. Its local
+//! error estimate is `(y_{n+1} - y_pred) / (k + 1)`. After `k + 1` steps at one size, the next
+//! size and order come from the estimates at orders `k - 1`, `k` and `k + 1`.
+//!
+//! **The Jacobian at every step.** SciPy and CVODE keep a Jacobian over many steps. On the
+//! drop model that fails: rolling in the race, the contact's and the support's stiffness
+//! turn with the contact angle, and the light race makes them large in `I - c J`; with the
+//! Jacobian of the step before, the iteration diverged on about half of the steps of the 1 s
+//! pendulum drop (2 204 failures in 4 146 steps, each then paying a new Jacobian and the
+//! iterations lost). So each attempt takes the Jacobian at its prediction `y_pred` (the model
+//! evaluation there serves the iteration's first right-hand side too) and factors `I - c J`.
+//!
+//! **One iteration where one is enough.** With the exact Jacobian at the starting point,
+//! Newton's iteration converges quadratically: the correction after the first one is about
+//! `K |dy_1|^2`. The constant `K` is measured on every attempt that iterates twice; while a
+//! measurement at most [`RECHECK_STEPS`] steps old predicts the second correction below the
+//! iteration's tolerance, the first iteration ends it. On the pendulum drop the second
+//! correction is some 1e-4 of the first, far below the tolerance.
+//!
+//! What it costs: after every restart it starts again at order 1 from a short step, so a
+//! drop with many mode switches takes many low-order steps (see [`super::Rodas4Bdf`], which
+//! leaves those to RODAS4), and a BDF of order 3 or more is not A-stable. Its interpolant is
+//! the polynomial through the last `k + 1` solution values (the drop's events are located on
+//! it).
+
+use super::control::StepCore;
+use super::rosw::Lu;
+use super::step::{Dense, StepControl, BACKWARD};
+use super::stepper::Stepper;
+use super::system::OdeSystem;
+use crate::error::SolveError;
+
+/// Highest order.
+pub(super) const MAX_ORDER: usize = 5;
+/// Most Newton iterations per attempt.
+const NEWTON_MAXITER: usize = 4;
+/// Smallest and largest step ratios.
+const MIN_FACTOR: f64 = 0.2;
+const MAX_FACTOR: f64 = 10.0;
+/// How many accepted steps a measured Newton constant `K` may serve before an attempt
+/// iterates twice again to measure it anew.
+const RECHECK_STEPS: u64 = 10;
+
+/// `gamma_k = sum_{j=1..k} 1/j`, `k = 0..=MAX_ORDER + 1`.
+const fn gammas() -> [f64; MAX_ORDER + 2] {
+    let mut g = [0.0; MAX_ORDER + 2];
+    let mut k = 1;
+    while k < MAX_ORDER + 2 {
+        g[k] = g[k - 1] + 1.0 / k as f64;
+        k += 1;
+    }
+    g
+}
+const GAMMA: [f64; MAX_ORDER + 2] = gammas();
+
+/// The error constant of order `k` in units of `nabla^{k+1} y`: `1 / (k + 1)`.
+#[inline]
+fn error_constant(k: usize) -> f64 {
+    1.0 / (k as f64 + 1.0)
+}
+
+/// Backward differences: rows `0..=MAX_ORDER + 2` (the last two hold the estimates of the
+/// next higher differences that the order selection reads).
+type Diffs<const N: usize> = [[f64; N]; MAX_ORDER + 3];
+
+/// The matrix `R(k, factor)` of the re-interpolation of the differences to a new spacing
+/// (Shampine and Reichelt, eq. 2.5): row 0 ones, then the cumulative products of
+/// `(i - 1 - factor j) / i`; zero outside rows and columns `0..=order`.
+fn interp_matrix(order: usize, factor: f64) -> [[f64; MAX_ORDER + 1]; MAX_ORDER + 1] {
+    const INV: [f64; MAX_ORDER + 1] = [0.0, 1.0, 1.0 / 2.0, 1.0 / 3.0, 1.0 / 4.0, 1.0 / 5.0];
+    let mut m = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
+    m[0][..=order].fill(1.0);
+    for i in 1..=order {
+        for j in 1..=order {
+            m[i][j] = m[i - 1][j] * ((i as f64 - 1.0 - factor * j as f64) * INV[i]);
+        }
+    }
+    m
+}
+
+/// Re-interpolates the differences of order `order` from spacing `h` to `factor h`:
+/// `D <- (R U)^T D` over rows `0..=order`, with `U = R(order, 1)`. Exact for a solution that
+/// is a polynomial of degree `order`. The rows above `order` are left as they are.
+fn change_spacing<const N: usize>(d: &mut Diffs<N>, order: usize, factor: f64) {
+    let r = interp_matrix(order, factor);
+    let u = interp_matrix(order, 1.0);
+    let mut ru = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
+    for i in 0..=order {
+        for k in 0..=order {
+            let rik = r[i][k];
+            for j in 0..=order {
+                ru[i][j] += rik * u[k][j];
+            }
+        }
+    }
+    let old = [d[0], d[1], d[2], d[3], d[4], d[5]];
+    for j in 0..=order {
+        let mut row = [0.0; N];
+        for (k, old_k) in old.iter().enumerate().take(order + 1) {
+            let w = ru[k][j];
+            for i in 0..N {
+                row[i] += w * old_k[i];
+            }
+        }
+        d[j] = row;
+    }
+}
+
+/// The root-mean-square norm of `c v` weighted by `1 / (atol + rtol |y|)`.
+#[inline]
+fn scaled_norm<const N: usize>(c: f64, v: &[f64; N], atol: &[f64; N], rtol: f64, y: &[f64; N]) -> f64 {
+    let mut s = 0.0;
+    for i in 0..N {
+        let x = c * v[i] / (atol[i] + rtol * y[i].abs());
+        s += x * x;
+    }
+    (s / N as f64).sqrt()
+}
+
+/// The BDF stepper: the backward differences, the order, the factored Newton matrix with its
+/// Jacobian, the Newton iteration's measured constant, and the work counters.
+#[derive(Debug, Clone)]
+pub struct Bdf<const N: usize> {
+    pub(super) core: StepCore<N>,
+    d: Diffs<N>,
+    order: usize,
+    /// Steps taken at the current size and order.
+    n_equal: usize,
+    lu: Lu,
+    /// Newton iterations, over every attempt.
+    newton_iterations: u64,
+    /// The measured constant `K` of the quadratic convergence (second correction over the
+    /// first's square, in the error norm), infinite before a measurement.
+    newton_k: f64,
+    /// Accepted steps since `newton_k` was measured.
+    newton_k_age: u64,
+}
+
+/// One attempt's outcome.
+enum Attempt<const N: usize> {
+    /// The iteration converged: the new state, its difference from the prediction, and the
+    /// iterations it took.
+    Converged([f64; N], [f64; N], usize),
+    /// It diverged or would not converge in [`NEWTON_MAXITER`] iterations.
+    Failed,
+}
+
+impl<const N: usize> Bdf<N> {
+    /// A stepper with the given control settings and no step-size history. On fixed steps
+    /// (`ctl.fixed_step`) it keeps the order it starts at: 1 after a restart.
+    pub fn new(ctl: StepControl<N>) -> Self {
+        Self {
+            core: StepCore::new(ctl, 5),
+            d: [[0.0; N]; MAX_ORDER + 3],
+            order: 1,
+            n_equal: 0,
+            lu: Lu::identity(),
+            newton_iterations: 0,
+            newton_k: f64::INFINITY,
+            newton_k_age: 0,
+        }
+    }
+
+    /// Newton iterations so far, over every attempt (each evaluates the model once).
+    pub fn newton_iterations(&self) -> u64 {
+        self.newton_iterations
+    }
+
+    /// The current order.
+    pub fn order(&self) -> usize {
+        self.order
+    }
+
+    /// Starts the method at order `values.len() - 1` and spacing `h` from the solution values
+    /// `values[j] = y(t - j h)`, `values[0]` the state the next step starts from (the step
+    /// after a one-step method's, [`super::Rodas4Bdf`]).
+    pub(super) fn seed(&mut self, values: &[[f64; N]], h: f64) {
+        let order = values.len() - 1;
+        debug_assert!((1..=MAX_ORDER).contains(&order));
+        // The difference table: after pass m, v[j] = nabla^m y(t - (j - m) h) for j >= m.
+        let mut v = [[0.0; N]; MAX_ORDER + 1];
+        v[..=order].copy_from_slice(values);
+        self.d = [[0.0; N]; MAX_ORDER + 3];
+        self.d[0] = values[0];
+        for m in 1..=order {
+            for j in (m..=order).rev() {
+                for i in 0..N {
+                    v[j][i] = v[j - 1][i] - v[j][i];
+                }
+            }
+            self.d[m] = v[m];
+        }
+        self.order = order;
+        self.n_equal = 0;
+        self.core.h = h;
+    }
+
+    /// Rescales the differences to a step `factor` times the current one.
+    fn rescale(&mut self, factor: f64) {
+        change_spacing(&mut self.d, self.order, factor);
+        self.core.h *= factor;
+        self.n_equal = 0;
+    }
+
+    /// One attempt at `t_new` from `y_pred` with `c = h / gamma_k`: the Jacobian at
+    /// `y_pred`, `I - c J` factored, then Newton's iteration on
+    /// `y - c f(t_new, y) = y_pred - psi`. It stops with SciPy's test (the contraction rate
+    /// `rho` of successive corrections: converged when `rho / (1 - rho) |dy| < tol`, failed
+    /// when `rho >= 1` or when the corrections left would not meet `tol` within
+    /// [`NEWTON_MAXITER`] iterations), or after one iteration when the measured constant
+    /// predicts the next correction below `tol` (see the module doc).
+    #[allow(clippy::too_many_arguments)]
+    fn attempt<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t_new: f64,
+        y_pred: &[f64; N],
+        psi: &[f64; N],
+        c: f64,
+        scale: &[f64; N],
+        tol: f64,
+    ) -> Attempt<N> {
+        sys.fill_stiff_jacobian(t_new, y_pred, &mut self.lu.j);
+        self.core.stats.jacobians += 1;
+        self.core.stats.factorizations += 1;
+        if !self.lu.factor(c) {
+            return Attempt::Failed;
+        }
+        let mut y = *y_pred;
+        let mut d = [0.0; N];
+        let mut dy_norm_old = f64::NAN;
+        for k in 0..NEWTON_MAXITER {
+            self.newton_iterations += 1;
+            let mut f = [0.0; N];
+            sys.rhs(t_new, &y, &mut f);
+            self.core.stats.rhs_evals += 1;
+            let mut dy = [0.0; N];
+            for i in 0..N {
+                dy[i] = c * f[i] - psi[i] - d[i];
+            }
+            self.lu.solve(&mut dy);
+            let mut sq = 0.0;
+            for i in 0..N {
+                let x = dy[i] / scale[i];
+                sq += x * x;
+            }
+            let dy_norm = (sq / N as f64).sqrt();
+            if !dy_norm.is_finite() {
+                return Attempt::Failed;
+            }
+            let rate = (k > 0).then(|| dy_norm / dy_norm_old);
+            if let Some(r) = rate {
+                if r >= 1.0 || r.powi((NEWTON_MAXITER - k) as i32) / (1.0 - r) * dy_norm > tol {
+                    return Attempt::Failed;
+                }
+                if k == 1 {
+                    self.newton_k = dy_norm / (dy_norm_old * dy_norm_old);
+                    self.newton_k_age = 0;
+                }
+            }
+            for i in 0..N {
+                y[i] += dy[i];
+                d[i] += dy[i];
+            }
+            let one_is_enough = k == 0
+                && self.newton_k_age < RECHECK_STEPS
+                && self.newton_k * dy_norm * dy_norm <= tol;
+            if one_is_enough
+                || dy_norm == 0.0
+                || rate.is_some_and(|r| r / (1.0 - r) * dy_norm < tol)
+            {
+                return Attempt::Converged(y, d, k + 1);
+            }
+            dy_norm_old = dy_norm;
+        }
+        Attempt::Failed
+    }
+}
+
+impl<const N: usize> Stepper<N> for Bdf<N> {
+    fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
+        let mut f = [0.0; N];
+        sys.rhs(t, y, &mut f);
+        self.core.restart(sys, y, &f);
+        self.order = 1;
+        self.n_equal = 0;
+        self.d = [[0.0; N]; MAX_ORDER + 3];
+        self.d[0] = *y;
+        let h = self.core.h;
+        for i in 0..N {
+            self.d[1][i] = h * f[i];
+        }
+    }
+
+    fn cap_next_step(&mut self, h_s: f64) {
+        if self.core.ctl.fixed_step.is_none() && self.core.h > h_s {
+            let factor = h_s / self.core.h;
+            self.rescale(factor);
+        }
+    }
+
+    fn step<S: OdeSystem<N>>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64; N],
+        h_cap: f64,
+    ) -> Result<&Dense<N>, SolveError> {
+        debug_assert!(
+            self.d[0] == *y,
+            "the BDF stepper continues only from its own last step"
+        );
+        self.core.begin_step(sys, t, y);
+        let rtol = self.core.ctl.rtol;
+        let atol = self.core.step_atol;
+        let fixed = self.core.ctl.fixed_step.is_some();
+        // SciPy's (and RADAU5's) stopping tolerance of the Newton iteration.
+        let newton_tol = (10.0 * f64::EPSILON / rtol).max(0.03_f64.min(rtol.sqrt()));
+        if self.core.h > h_cap {
+            self.rescale(h_cap / self.core.h);
+        }
+        let (y_new, d_new, error_norm, safety) = loop {
+            let attempts = self.core.stats.steps + self.core.stats.rejected;
+            if attempts >= self.core.ctl.max_attempts {
+                return Err(SolveError::StepBudget { t_s: t, attempts });
+            }
+            let h = self.core.h;
+            if h < self.core.ctl.h_min {
+                return Err(SolveError::StepSizeUnderflow { t_s: t, h_s: h });
+            }
+            let order = self.order;
+            let mut y_pred = [0.0; N];
+            let mut psi = [0.0; N];
+            for j in 0..=order {
+                for i in 0..N {
+                    y_pred[i] += self.d[j][i];
+                }
+            }
+            for j in 1..=order {
+                let w = GAMMA[j] / GAMMA[order];
+                for i in 0..N {
+                    psi[i] += w * self.d[j][i];
+                }
+            }
+            let scale: [f64; N] = std::array::from_fn(|i| atol[i] + rtol * y_pred[i].abs());
+            let c = h / GAMMA[order];
+            let Attempt::Converged(y_new, d, iterations) =
+                self.attempt(sys, t + h, &y_pred, &psi, c, &scale, newton_tol)
+            else {
+                if fixed {
+                    return Err(SolveError::NonFiniteState { t_s: t });
+                }
+                self.core.stats.rejected += 1;
+                self.rescale(0.5);
+                continue;
+            };
+            // SciPy's safety factor, counting an iteration that ended after one as two (with
+            // it counted as one, the 1 s pendulum drop took 6 507 steps with 606 rejections
+            // against 5 481 and 314).
+            let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64
+                / (2 * NEWTON_MAXITER + iterations.max(2)) as f64;
+            let error_norm = scaled_norm(error_constant(order), &d, &atol, rtol, &y_new);
+            if !fixed && !(error_norm <= 1.0) {
+                self.core.stats.rejected += 1;
+                let factor = if error_norm.is_finite() {
+                    (safety * error_norm.powf(-1.0 / (order as f64 + 1.0))).max(MIN_FACTOR)
+                } else {
+                    MIN_FACTOR
+                };
+                self.rescale(factor);
+                continue;
+            }
+            break (y_new, d, error_norm, safety);
+        };
+        let h = self.core.h;
+        let order = self.order;
+        self.n_equal += 1;
+        self.newton_k_age += 1;
+        // The differences of the new step: nabla^{k+1} y_{n+1} = d, then downwards.
+        for i in 0..N {
+            self.d[order + 2][i] = d_new[i] - self.d[order + 1][i];
+            self.d[order + 1][i] = d_new[i];
+        }
+        for j in (0..=order).rev() {
+            for i in 0..N {
+                self.d[j][i] += self.d[j + 1][i];
+            }
+        }
+        // The summed differences differ from y_new in the last bits: the stepper goes on from
+        // the state it reports.
+        self.d[0] = y_new;
+        // The interpolant: the polynomial through y_{n+1}, ..., y_{n+1-k}.
+        let dense = &mut self.core.dense;
+        dense.r[..=order].copy_from_slice(&self.d[..=order]);
+        (dense.t0, dense.h, dense.t_end) = (t, h, t + h);
+        dense.terms = BACKWARD + order;
+        (dense.y0, dense.y1) = (*y, y_new);
+        self.core.stats.steps += 1;
+        if self.n_equal > order && !fixed {
+            // The next order and size from the error estimates at orders k - 1, k, k + 1.
+            let e_minus = if order > 1 {
+                scaled_norm(error_constant(order - 1), &self.d[order], &atol, rtol, &y_new)
+            } else {
+                f64::INFINITY
+            };
+            let e_plus = if order < MAX_ORDER {
+                scaled_norm(error_constant(order + 1), &self.d[order + 2], &atol, rtol, &y_new)
+            } else {
+                f64::INFINITY
+            };
+            let mut best = (order, error_norm.powf(-1.0 / (order as f64 + 1.0)));
+            for (k, e) in [(order - 1, e_minus), (order + 1, e_plus)] {
+                let f = e.powf(-1.0 / (k as f64 + 1.0));
+                if f > best.1 {
+                    best = (k, f);
+                }
+            }
+            self.order = best.0;
+            self.rescale((safety * best.1).min(MAX_FACTOR));
+        }
+        Ok(&self.core.dense)
+    }
+
+    fn core(&self) -> &StepCore<N> {
+        &self.core
+    }
+    fn core_mut(&mut self) -> &mut StepCore<N> {
+        &mut self.core
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `y' = p'(t)` for a polynomial `p` of degree 4, both components.
+    struct Poly;
+    fn p(t: f64) -> f64 {
+        1.0 + t - 0.5 * t * t + 0.25 * t.powi(3) - 0.125 * t.powi(4)
+    }
+    fn dp(t: f64) -> f64 {
+        1.0 - t + 0.75 * t * t - 0.5 * t.powi(3)
+    }
+    impl OdeSystem<2> for Poly {
+        type Guard = crate::ode::NoGuard;
+        fn rhs(&self, t: f64, _y: &[f64; 2], dy: &mut [f64; 2]) {
+            dy[0] = dp(t);
+            dy[1] = 2.0 * dp(t);
+        }
+    }
+    fn ctl(fixed: Option<f64>) -> StepControl<2> {
+        StepControl {
+            rtol: 1e-6,
+            atol: [1e-9; 2],
+            h_min: 1e-14,
+            max_attempts: 1_000_000,
+            fixed_step: fixed,
+        }
+    }
+
+    #[test]
+    fn re_interpolation_is_exact_for_a_polynomial_of_the_order() {
+        // Differences of p at spacing 0.1 behind t = 1, re-spaced to 0.037: those of p at
+        // spacing 0.037, for p of degree 4 and order 4.
+        let diffs = |h: f64| {
+            let mut st = Bdf::<2>::new(ctl(None));
+            let v: Vec<[f64; 2]> = (0..=4)
+                .map(|j| {
+                    let x = p(1.0 - j as f64 * h);
+                    [x, 2.0 * x]
+                })
+                .collect();
+            st.seed(&v, h);
+            st.d
+        };
+        let mut d = diffs(0.1);
+        change_spacing(&mut d, 4, 0.37);
+        let want = diffs(0.037);
+        for j in 0..=4 {
+            for i in 0..2 {
+                assert!(
+                    (d[j][i] - want[j][i]).abs() < 1e-13,
+                    "row {j}: {} against {}",
+                    d[j][i],
+                    want[j][i]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn order_k_integrates_a_polynomial_of_degree_k_exactly_and_its_interpolant_too() {
+        // Seeded at order 4 from exact values, fixed steps: the BDF of order 4 is exact for
+        // polynomials of degree 4, and so is the interpolant through its last five values.
+        let h = 0.05;
+        let mut st = Bdf::<2>::new(ctl(Some(h)));
+        let v: Vec<[f64; 2]> = (0..=4)
+            .map(|j| {
+                let x = p(-(j as f64) * h);
+                [x, 2.0 * x]
+            })
+            .collect();
+        st.seed(&v, h);
+        let (mut t, mut y) = (0.0, v[0]);
+        for _ in 0..20 {
+            let dense = st.step(&Poly, t, &y, f64::INFINITY).unwrap().clone();
+            for th in [0.1, 0.5, 0.9] {
+                let tm = t + th * h;
+                let ym = dense.eval(tm);
+                assert!((ym[0] - p(tm)).abs() < 1e-12, "interpolant at {tm}: {}", ym[0]);
+            }
+            assert_eq!(dense.y0(), y);
+            t = dense.t1();
+            y = dense.y1();
+            assert!((y[0] - p(t)).abs() < 1e-12 && (y[1] - 2.0 * p(t)).abs() < 1e-12);
+        }
+        assert_eq!(st.order(), 4);
+    }
+
+    #[test]
+    fn fixed_steps_converge_at_the_seeded_order() {
+        // y' = -y from exact values: the global error of order k falls as h^k.
+        struct Decay;
+        impl OdeSystem<1> for Decay {
+            type Guard = crate::ode::NoGuard;
+            fn rhs(&self, _t: f64, y: &[f64; 1], dy: &mut [f64; 1]) {
+                dy[0] = -y[0];
+            }
+            fn stiff_jacobian(&self, _t: f64, _y: &[f64; 1]) -> Option<crate::ode::StiffJacobian> {
+                let mut s = crate::ode::StiffJacobian::over(&[0]);
+                s.jac[(0, 0)] = -1.0;
+                Some(s)
+            }
+        }
+        for order in 1..=MAX_ORDER {
+            let err = |n: usize| {
+                let h = 1.0 / n as f64;
+                let mut st = Bdf::<1>::new(StepControl {
+                    rtol: 1e-12,
+                    atol: [1e-12],
+                    h_min: 0.0,
+                    max_attempts: u64::MAX,
+                    fixed_step: Some(h),
+                });
+                let v: Vec<[f64; 1]> = (0..=order).map(|j| [(j as f64 * h).exp()]).collect();
+                st.seed(&v, h);
+                let (mut t, mut y) = (0.0, v[0]);
+                for _ in 0..n {
+                    let d = st.step(&Decay, t, &y, f64::INFINITY).unwrap();
+                    (t, y) = (d.t1(), d.y1());
+                }
+                (y[0] - (-t).exp()).abs()
+            };
+            let observed = (err(20) / err(40)).log2();
+            assert!(
+                (observed - order as f64).abs() < 0.25,
+                "order {order}: observed {observed:.2}"
+            );
+        }
+    }
+}
