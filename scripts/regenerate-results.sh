@@ -50,14 +50,16 @@ for part in "${parts[@]}"; do
       done ;;
     accuracy)
       for s in accuracy:accuracy-cases accuracy-radial:accuracy-radial accuracy-implicit:accuracy-implicit \
-               accuracy-rodas4:accuracy-rodas4 accuracy-rodas5p:accuracy-rodas5p accuracy-draft:accuracy-draft; do
+               accuracy-rodas4:accuracy-rodas4 accuracy-rodas5p:accuracy-rodas5p accuracy-draft:accuracy-draft \
+               accuracy-bdf:accuracy-bdf; do
         out=${s%%:*}; cases=${s##*:}
         rm -rf "results/$out"
         "$W" accuracy --cases "sweeps/$cases.json" --out "results/$out"
       done ;;
     accuracy-charts)
       for s in accuracy:accuracy-cases accuracy-radial:accuracy-radial accuracy-implicit:accuracy-implicit \
-               accuracy-rodas4:accuracy-rodas4 accuracy-rodas5p:accuracy-rodas5p accuracy-draft:accuracy-draft; do
+               accuracy-rodas4:accuracy-rodas4 accuracy-rodas5p:accuracy-rodas5p accuracy-draft:accuracy-draft \
+               accuracy-bdf:accuracy-bdf; do
         out=${s%%:*}; cases=${s##*:}
         "$W" accuracy --cases "sweeps/$cases.json" --out "results/$out" --charts-only
       done ;;

@@ -114,19 +114,19 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
                 s.solver.rtol = 1e-5;
             },
         },
-        // RODAS4 then BDF, and the BDF alone, with `standard`'s other numerics
-        // (docs/performance.md#rodas4-then-bdf).
+        // `standard`'s stepper until model version 11, and the BDF alone, with `standard`'s
+        // other numerics (docs/performance.md#rodas4-then-bdf-model-version-12).
         Case {
-            name: "pendulum 1 s, rodas4_bdf",
+            name: "pendulum 1 s, rodas4 (standard to v11)",
             speed_rpm: 8000.0,
             mu: 0.1,
-            edit: |s| s.solver.method = whirlmap_core::Method::Rodas4Bdf,
+            edit: |s| s.solver.method = whirlmap_core::Method::Rodas4,
         },
         Case {
-            name: "whirl, rodas4_bdf",
+            name: "whirl, rodas4 (standard to v11)",
             speed_rpm: 8000.0,
             mu: 0.4,
-            edit: |s| s.solver.method = whirlmap_core::Method::Rodas4Bdf,
+            edit: |s| s.solver.method = whirlmap_core::Method::Rodas4,
         },
         Case {
             name: "pendulum 1 s, bdf alone",
@@ -161,6 +161,7 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             edit: |s| {
                 s.solver.rtol = 1e-6;
                 s.solver.race_velocity_atol_from_force = false;
+                s.solver.method = whirlmap_core::Method::Rodas4;
             },
         },
         Case {

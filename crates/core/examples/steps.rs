@@ -23,7 +23,13 @@ impl Observer<model::DropSystem, { model::N }> for Rec {
             model::Slip::Sticking => 0,
             model::Slip::Slipping(x) => x as i32,
         };
-        self.0.push((s.dense.t0(), s.dense.t1(), m.contact, sl, sys.model_evals().computed));
+        self.0.push((
+            s.dense.t0(),
+            s.dense.t1(),
+            m.contact,
+            sl,
+            sys.model_evals().computed,
+        ));
         if !m.contact {
             use whirlmap_core::ode::OdeSystem;
             let cap = sys.max_step_at(s.dense.t0(), &s.dense.y0());

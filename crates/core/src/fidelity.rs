@@ -16,15 +16,17 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
-    /// Screening: RODAS4 (as `standard`) with the free-flight gap bound and the race's
-    /// absolute tolerances x1000, at rtol 1e-4: the most accurate setting at its cost in the
-    /// `draft` study (`results/accuracy-draft/`). About half of `standard`'s time, but
-    /// outside the accuracy budget: on bouncing sequences its maximum force is off by up to
-    /// 0.23 % (docs/accuracy.md#fidelity-presets).
+    /// Screening: RODAS4 with the free-flight gap bound and the race's absolute tolerances
+    /// x1000, at rtol 1e-4: the most accurate setting at its cost in the `draft` study
+    /// (`results/accuracy-draft/`). About 0.7 of `standard`'s time, but outside the
+    /// accuracy budget: on bouncing sequences its maximum force is off by up to 0.23 %
+    /// (docs/accuracy.md#fidelity-presets).
     Draft,
-    /// Design work, and the scene default: RODAS4 on the full Jacobian at rtol 3e-5, with the
-    /// free-flight gap bound and the race's velocity tolerance widened from the contact force
-    /// in contact (every other tolerance the rotor's); within the budget with its tolerance
+    /// Design work, and the scene default: RODAS4 then BDF (RODAS4 after every mode switch,
+    /// the BDF at a tenth of the tolerance once the contact has run smoothly for 2 ms; model
+    /// version 12) on the full Jacobian at rtol 3e-5, with the free-flight gap bound and the
+    /// race's velocity tolerance widened from the contact force in contact (every other
+    /// tolerance the rotor's); within the budget with its tolerance
     /// neighbours within it too, with a margin of two on the worst case (first and maximum
     /// contact force and peak heat power within 0.1 % of `reference`, whirl frequency within
     /// 1 %, the same class away from a transition; docs/accuracy.md#fidelity-presets).

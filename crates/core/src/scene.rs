@@ -45,9 +45,8 @@ pub enum Method {
     /// evaluations and about the same time (docs/accuracy.md#why-draft-is-rodas4).
     Ros34pw2,
     /// RODAS4, a Rosenbrock method of order 4 (Hairer and Wanner) on the full Jacobian and
-    /// the factors of ROS34PW2 (`ode/rodas.rs`): the `standard` fidelity's (the scene
-    /// default), and the `draft` fidelity's at rtol 1e-4.
-    #[default]
+    /// the factors of ROS34PW2 (`ode/rodas.rs`): the `draft` fidelity's at rtol 1e-4, and the
+    /// `standard` fidelity's (the scene default) until model version 11.
     Rodas4,
     /// Rodas5P, a Rosenbrock method of order 5 (Steinebach 2023) on the full Jacobian and
     /// the factors of RODAS4 (`ode/rodas5p.rs`).
@@ -62,6 +61,8 @@ pub enum Method {
     Bdf,
     /// RODAS4 after every mode switch, the BDF once the contact has carried for 12 steps and
     /// 2 ms (`ode/rodas_bdf.rs`): RODAS4 takes the impacts, the BDF the rolling and the whirl.
+    /// The `standard` fidelity's (the scene default) since model version 12.
+    #[default]
     Rodas4Bdf,
 }
 
@@ -120,17 +121,18 @@ pub struct SolverSettings {
     pub max_step_attempts: u64,
     /// Located mode switches before a typed budget error (chatter guard). Default 2 000 000.
     pub max_events: u64,
-    /// The integrator. Default `rodas4`, the 4th-order Rosenbrock method on the model's full
-    /// Jacobian, whose step is not bounded by the light race's contact modes (the `standard`
-    /// and `draft` fidelities'); `dopri5`, the explicit Dormand-Prince 5(4) pair (the
-    /// `reference` fidelity's); `ros34pw2`, the 3rd-order Rosenbrock-W method;
-    /// `dop853` the independent reference of `whirlmap accuracy`; `rodas5p`, the 5th-order
-    /// Rosenbrock method on RODAS4's Jacobian, for errors below about 1e-5 (docs/accuracy.md);
-    /// `radau5`, the 5th-order Radau IIA collocation method on the same Jacobian, about half
-    /// of RODAS4's steps on a pendulum drop at a higher cost per step (docs/performance.md);
-    /// `bdf`, the variable-order backward differentiation formulas; `rodas4_bdf`, RODAS4
-    /// after each mode switch and the BDF once the contact has run smoothly
-    /// (docs/model.md#integrator).
+    /// The integrator. Default `rodas4_bdf` (the `standard` fidelity's): RODAS4
+    /// after each mode switch, which takes the impacts, and the variable-order BDF once the
+    /// contact has run smoothly for 2 ms (docs/model.md#integrator); `rodas4`, the
+    /// 4th-order Rosenbrock method on the model's full Jacobian, whose step is not bounded by
+    /// the light race's contact modes (the `draft` fidelity's, and the default until model
+    /// version 11); `bdf`, the BDF
+    /// alone; `dopri5`, the explicit Dormand-Prince 5(4) pair (the `reference` fidelity's);
+    /// `ros34pw2`, the 3rd-order Rosenbrock-W method; `dop853` the independent reference of
+    /// `whirlmap accuracy`; `rodas5p`, the 5th-order Rosenbrock method on RODAS4's Jacobian,
+    /// for errors below about 1e-5 (docs/accuracy.md); `radau5`, the 5th-order Radau IIA
+    /// collocation method on the same Jacobian, about half of RODAS4's steps on a pendulum
+    /// drop at a higher cost per step (docs/performance.md).
     pub method: Method,
     /// In free flight, let the step exceed `free_flight_max_step_s` up to a quarter of a
     /// lower bound on the time until the contact can close (gap, relative speed, and a
@@ -165,8 +167,8 @@ pub struct SolverSettings {
 // Exact comparison on purpose: only the default is left out of the JSON.
 
 impl Default for SolverSettings {
-    /// The `standard` fidelity ([`crate::Fidelity::Standard`]): RODAS4 at rtol 3e-5 with the
-    /// free-flight gap bound and the race's velocity tolerance widened from the contact force
+    /// The `standard` fidelity ([`crate::Fidelity::Standard`]): RODAS4 then BDF at rtol 3e-5
+    /// with the free-flight gap bound and the race's velocity tolerance widened from the contact force
     /// (every other tolerance the rotor's), within the accuracy budget with both its
     /// tolerance neighbours within it too, on the main job's grid and on cases with long
     /// bouncing sequences (docs/accuracy.md#fidelity-presets).
@@ -178,7 +180,7 @@ impl Default for SolverSettings {
             min_step_s: 1e-13,
             max_step_attempts: 20_000_000,
             max_events: 2_000_000,
-            method: Method::Rodas4,
+            method: Method::Rodas4Bdf,
             free_flight_gap_bound: true,
             race_atol_scale: 1.0,
             race_velocity_atol_from_force: true,

@@ -1302,7 +1302,7 @@ impl Observer<DropSystem, N> for HeatWatch {
     }
 }
 
-/// The scene defaults (the `standard` fidelity: RODAS4 at rtol 3e-5) keep the invariants to their own tolerance: the energy audit closes to less
+/// The scene defaults (the `standard` fidelity: RODAS4 then BDF at rtol 3e-5) keep the invariants to their own tolerance: the energy audit closes to less
 /// than rtol of the largest energy, the friction heat never falls by more than rtol of itself
 /// (while the contact sticks, its slip velocity is held by the constraint to integration
 /// error, so F_t v_rel may dip below zero by that much), and the first impact is within the

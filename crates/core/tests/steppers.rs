@@ -523,7 +523,9 @@ fn global_error_falls_in_proportion_to_the_tolerance() {
             let slope = (errs[0] / errs[2]).ln() / (m.rtols[0] / m.rtols[2]).ln();
             println!("{} on {name}: errors {errs:?}, slope {slope:.2}", m.name);
             assert!(
-                errs[1] < errs[0] && errs[2] < errs[1] && (slope - m.tol_slope).abs() <= m.slope_margin,
+                errs[1] < errs[0]
+                    && errs[2] < errs[1]
+                    && (slope - m.tol_slope).abs() <= m.slope_margin,
                 "{} on {name}: errors {errs:?} for rtol {:?} (slope {slope:.2})",
                 m.name,
                 m.rtols

@@ -309,7 +309,11 @@ fn the_bdf_alone_converges_on_the_bouncing_drop() {
             .max((f.max_contact_force_n - rf.max_contact_force_n).abs() / rf.max_contact_force_n);
         eprintln!("Bdf rtol {rtol:e}: force error {err:e}, {:?}", r.stats);
         assert_eq!(f.impacts, rf.impacts, "rtol {rtol:e}");
-        assert!(r.energy.residual_rel < 1e-5, "rtol {rtol:e}: {:?}", r.energy);
+        assert!(
+            r.energy.residual_rel < 1e-5,
+            "rtol {rtol:e}: {:?}",
+            r.energy
+        );
         errs.push(err);
     }
     assert!(errs[1] < errs[0] && errs[2] < errs[1], "{errs:?}");
@@ -357,11 +361,12 @@ fn converges_to(reference: &whirlmap_core::DropReport, method: Method) {
 
 /// RODAS4 then BDF leaves every impact to RODAS4: on the 1 s pendulum drop, whose budgeted
 /// outputs all come from its first impact, the first and the maximum contact force and the
-/// peak heat power are RODAS4's to the bit. The rolling that follows, stepped by the BDF,
-/// ends in the same class with the friction heat within a few tolerances of RODAS4's, for
-/// less than half of its right-hand-side evaluations and steps.
+/// peak heat power are RODAS4's to the bit. The rolling that follows, stepped by the BDF at a
+/// tenth of the tolerance, ends in the same class with the friction heat within a few
+/// tolerances of RODAS4's, in about as many steps for less than half of the right-hand-side
+/// evaluations (one or two a step against six).
 #[test]
-fn rodas4_then_bdf_keeps_rodas4s_impacts_and_rolls_for_less() {
+fn rodas4_then_bdf_keeps_rodas4s_impacts_and_rolls_for_fewer_evaluations() {
     let run = |method| {
         let mut s = Scene::paper();
         s.solver.method = method;
@@ -370,17 +375,98 @@ fn rodas4_then_bdf_keeps_rodas4s_impacts_and_rolls_for_less() {
     let (a, b) = (run(Method::Rodas4), run(Method::Rodas4Bdf));
     let (fa, fb) = (&a.features, &b.features);
     for (name, x, y) in [
-        ("first force", fa.first_contact_force_n, fb.first_contact_force_n),
-        ("maximum force", fa.max_contact_force_n, fb.max_contact_force_n),
-        ("peak heat power", fa.peak_heat_power_w, fb.peak_heat_power_w),
+        (
+            "first force",
+            fa.first_contact_force_n,
+            fb.first_contact_force_n,
+        ),
+        (
+            "maximum force",
+            fa.max_contact_force_n,
+            fb.max_contact_force_n,
+        ),
+        (
+            "peak heat power",
+            fa.peak_heat_power_w,
+            fb.peak_heat_power_w,
+        ),
     ] {
         assert_eq!(x.to_bits(), y.to_bits(), "{name}: {x} against {y}");
     }
     assert_eq!(a.verdict.class, b.verdict.class);
     let heat = |r: &whirlmap_core::DropReport| r.energy.friction_heat_j;
     let rel = (heat(&a) - heat(&b)).abs() / heat(&a);
-    assert!(rel < 10.0 * Scene::paper().solver.rtol, "friction heat apart by {rel:e}");
+    assert!(
+        rel < 10.0 * Scene::paper().solver.rtol,
+        "friction heat apart by {rel:e}"
+    );
     eprintln!("RODAS4 {:?}\nRODAS4 then BDF {:?}", a.stats, b.stats);
-    assert!(2 * b.stats.rhs_evals < a.stats.rhs_evals, "{:?} against {:?}", b.stats, a.stats);
-    assert!(3 * b.stats.steps < 2 * a.stats.steps, "{:?}", b.stats);
+    assert!(
+        2 * b.stats.rhs_evals < a.stats.rhs_evals,
+        "{:?} against {:?}",
+        b.stats,
+        a.stats
+    );
+    assert!(
+        b.stats.steps < a.stats.steps + a.stats.steps / 10,
+        "{:?}",
+        b.stats
+    );
+}
+
+/// The thermal model runs the dynamics in macro steps of 1 ms, each ended by the observer;
+/// the next macro step goes on from the same state with the drag's load a step further
+/// (eq. 31). RODAS4 then BDF keeps its BDF across them (it hands over only after 2 ms, so a
+/// restart at each would leave every step to RODAS4): the thermal drop takes as few
+/// right-hand-side evaluations as the drop without the thermal model, and its outputs are
+/// within a few tolerances of RODAS4's.
+#[test]
+fn rodas4_then_bdf_keeps_its_bdf_across_the_thermal_macro_steps() {
+    let run = |method, thermal: bool| {
+        let mut s = Scene::paper();
+        s.solver.method = method;
+        if thermal {
+            s.thermal = Some(whirlmap_core::ThermalParams::default());
+        }
+        whirlmap_core::simulate(&s, &DropOptions::default()).unwrap()
+    };
+    let plain = run(Method::Rodas4Bdf, false);
+    let (a, b) = (run(Method::Rodas4, true), run(Method::Rodas4Bdf, true));
+    eprintln!(
+        "RODAS4 {:?}\nRODAS4 then BDF {:?}\nwithout the thermal model {:?}",
+        a.stats, b.stats, plain.stats
+    );
+    assert!(
+        b.stats.rhs_evals < plain.stats.rhs_evals + plain.stats.rhs_evals / 10,
+        "{:?} against {:?}",
+        b.stats,
+        plain.stats
+    );
+    assert!(
+        2 * b.stats.rhs_evals < a.stats.rhs_evals,
+        "{:?} against {:?}",
+        b.stats,
+        a.stats
+    );
+    let rtol = Scene::paper().solver.rtol;
+    let (ta, tb) = (a.thermal.as_ref().unwrap(), b.thermal.as_ref().unwrap());
+    for (name, x, y) in [
+        (
+            "friction heat",
+            a.energy.friction_heat_j,
+            b.energy.friction_heat_j,
+        ),
+        ("drag work", a.energy.drag_work_j, b.energy.drag_work_j),
+        (
+            "final thermal load",
+            ta.final_thermal_load_n,
+            tb.final_thermal_load_n,
+        ),
+    ] {
+        assert!(
+            (x - y).abs() <= 10.0 * rtol * x.abs(),
+            "{name}: {x} against {y}"
+        );
+    }
+    assert_eq!(a.verdict.class, b.verdict.class);
 }

@@ -10,11 +10,12 @@
 //! [`SEED_ORDER`] and RODAS4's step size from RODAS4's last steps, read at equal spacing from
 //! their cubic Hermite interpolants (RODAS4's own dense output).
 //!
-//! Why: rolling or whirling in the race, a BDF step costs about a third of a RODAS4 step (one
-//! model evaluation, one Jacobian, one factorisation and one solve, against six, one, one and
-//! six) and, at orders 4 and 5, takes steps about twice as long at the same tolerance. But
-//! started after each switch at order 1, the BDF alone missed the accuracy budget by up to 48
-//! times on the impacts of a bouncing sequence (docs/performance.md).
+//! Why: rolling or whirling in the race, a BDF step costs one or two model evaluations, one
+//! Jacobian, one factorisation and one or two solves, against RODAS4's six, one, one and six;
+//! at a tenth of the tolerance ([`BDF_TOLERANCE`]) it takes about as many steps as RODAS4
+//! and is as close to `reference`. Started after each switch at order 1, the BDF alone missed
+//! the accuracy budget by up to fourteen times on the impacts of a bouncing sequence
+//! (docs/accuracy.md#model-version-12-rodas4-then-bdf).
 
 use super::bdf::{Bdf, MAX_ORDER};
 use super::control::StepCore;
@@ -29,6 +30,14 @@ pub const HANDOVER_STEPS: usize = 12;
 /// Time since a restart before the BDF may take over (s): longer than a touchdown impact
 /// (about 1.6 ms at the paper's contact), so that RODAS4 takes every impact whole.
 pub const HANDOVER_S: f64 = 2e-3;
+/// The BDF's tolerances, as a fraction of the stepper's. RODAS4's error estimate is the
+/// distance to its embedded third-order solution, so its fourth-order solution is well within
+/// the tolerance; the BDF's estimate is its own solution's error. At a tenth of the tolerance
+/// the BDF's steps are as accurate as RODAS4's: on the main job's grid the worst maximum
+/// contact force of a whirl (stepped by the BDF) is 4.7e-4 from `reference` against RODAS4's
+/// 5.0e-4; at the same tolerance it was 2.1e-3, outside the budget, and at a third 8.2e-4
+/// (docs/performance.md#rodas4-then-bdf-model-version-12).
+pub const BDF_TOLERANCE: f64 = 0.1;
 /// The BDF's order when it takes over.
 const SEED_ORDER: usize = 3;
 /// RODAS4 step ends kept for the hand-over (more than [`SEED_ORDER`] steps' worth).
@@ -56,6 +65,9 @@ pub struct Rodas4Bdf<const N: usize> {
     t_restart: f64,
     /// Hand-overs to the BDF so far.
     handovers: u64,
+    /// Whether the next restart keeps the history
+    /// ([`Stepper::keep_history_at_next_restart`]).
+    keep_history: bool,
 }
 
 impl<const N: usize> Rodas4Bdf<N> {
@@ -64,12 +76,17 @@ impl<const N: usize> Rodas4Bdf<N> {
         const { assert!(SEED_ORDER <= MAX_ORDER && SEED_ORDER < HISTORY) };
         Self {
             rodas: Rodas4::new(ctl),
-            bdf: Bdf::new(ctl),
+            bdf: Bdf::new(StepControl {
+                rtol: ctl.rtol * BDF_TOLERANCE,
+                atol: ctl.atol.map(|a| a * BDF_TOLERANCE),
+                ..ctl
+            }),
             phase: Phase::Rodas,
             history: Vec::with_capacity(HISTORY),
             since_restart: 0,
             t_restart: 0.0,
             handovers: 0,
+            keep_history: false,
         }
     }
 
@@ -134,6 +151,19 @@ impl<const N: usize> Rodas4Bdf<N> {
 
 impl<const N: usize> Stepper<N> for Rodas4Bdf<N> {
     fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]) {
+        if std::mem::take(&mut self.keep_history) {
+            match self.phase {
+                // The BDF goes on with its differences.
+                Phase::Bdf if self.bdf.d0() == y => return,
+                // RODAS4 takes the derivative anew and keeps its count towards the hand-over.
+                Phase::Rodas if self.history.last().is_some_and(|h| h.1 == *y) => {
+                    self.rodas.restart(sys, t, y);
+                    self.history.last_mut().expect("checked").2 = self.rodas.f0;
+                    return;
+                }
+                _ => {}
+            }
+        }
         if self.phase == Phase::Bdf {
             // RODAS4 goes on from the BDF's step size.
             self.rodas.core_mut().h = self.bdf.core.h;
@@ -180,6 +210,9 @@ impl<const N: usize> Stepper<N> for Rodas4Bdf<N> {
             Phase::Rodas => self.rodas.core_mut(),
             Phase::Bdf => &mut self.bdf.core,
         }
+    }
+    fn keep_history_at_next_restart(&mut self) {
+        self.keep_history = true;
     }
     /// Both methods' counters together.
     fn stats(&self) -> Stats {

@@ -40,6 +40,12 @@ pub trait Stepper<const N: usize> {
     fn stats(&self) -> Stats {
         self.core().stats
     }
+    /// Says that the next [`Stepper::restart`] follows no mode switch: the run stopped at an
+    /// end time or an observer's halt and goes on from the same state, with the system's
+    /// right-hand side the same or changed by a small parameter step (the thermal coupling's
+    /// macro step). A stepper with a history (the BDF) may then keep it; the default does
+    /// nothing, and a one-step method restarts as always.
+    fn keep_history_at_next_restart(&mut self) {}
     /// Counts one located event.
     fn count_event(&mut self) {
         self.core_mut().stats.events += 1;
