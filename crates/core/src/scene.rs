@@ -168,9 +168,9 @@ pub struct SolverSettings {
 
 impl Default for SolverSettings {
     /// The `standard` fidelity ([`crate::Fidelity::Standard`]): RODAS4 then BDF at rtol 3e-5
-    /// with the free-flight gap bound and the race's velocity tolerance widened from the contact force
-    /// (every other tolerance the rotor's), within the accuracy budget with both its
-    /// tolerance neighbours within it too, on the main job's grid and on cases with long
+    /// with the free-flight gap bound and the race's velocity tolerance widened from the
+    /// contact force (every other tolerance the rotor's), within the accuracy budget with both
+    /// its tolerance neighbours within it too, on the main job's grid and on cases with long
     /// bouncing sequences (docs/accuracy.md#fidelity-presets).
     fn default() -> Self {
         Self {

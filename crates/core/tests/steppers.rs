@@ -22,6 +22,9 @@ use whirlmap_core::ode::{
     Rodas5p, Ros34pw2, StepControl, Stepper, StiffJacobian, Stop,
 };
 
+mod common;
+use common::Harmonic;
+
 /// A reference problem: a two-component system with its exact solution.
 trait Reference: OdeSystem<2, Guard = NoGuard> {
     /// Its name, for messages.
@@ -64,29 +67,6 @@ impl Reference for Decay {
     }
 }
 
-/// x'' = -x as a first-order system: cos t, -sin t. `wrong_jacobian` hands the implicit
-/// stepper a matrix that is not the Jacobian.
-struct Harmonic {
-    wrong_jacobian: bool,
-}
-impl OdeSystem<2> for Harmonic {
-    type Guard = NoGuard;
-    fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
-        dy[0] = y[1];
-        dy[1] = -y[0];
-    }
-    fn stiff_jacobian(&self, _t: f64, _y: &[f64; 2]) -> Option<StiffJacobian> {
-        let mut s = StiffJacobian::over(&[0, 1]);
-        if self.wrong_jacobian {
-            s.jac[(1, 0)] = -3.0;
-            s.jac[(0, 0)] = 0.7;
-        } else {
-            s.jac[(0, 1)] = 1.0;
-            s.jac[(1, 0)] = -1.0;
-        }
-        Some(s)
-    }
-}
 impl Reference for Harmonic {
     fn name(&self) -> &'static str {
         if self.wrong_jacobian {

@@ -14,8 +14,8 @@
 //! Jacobian, one factorisation and one or two solves, against RODAS4's six, one, one and six;
 //! at a tenth of the tolerance ([`BDF_TOLERANCE`]) it takes about as many steps as RODAS4
 //! and is as close to `reference`. Started after each switch at order 1, the BDF alone missed
-//! the accuracy budget by up to fourteen times on the impacts of a bouncing sequence
-//! (docs/accuracy.md#model-version-12-rodas4-then-bdf).
+//! the accuracy budget at rtol 3e-5 by up to sixteen times on the impacts of a bouncing
+//! sequence (docs/accuracy.md#model-version-12-rodas4-then-bdf).
 
 use super::bdf::{Bdf, MAX_ORDER};
 use super::control::StepCore;
@@ -30,13 +30,15 @@ pub const HANDOVER_STEPS: usize = 12;
 /// Time since a restart before the BDF may take over (s): longer than a touchdown impact
 /// (about 1.6 ms at the paper's contact), so that RODAS4 takes every impact whole.
 pub const HANDOVER_S: f64 = 2e-3;
-/// The BDF's tolerances, as a fraction of the stepper's. RODAS4's error estimate is the
-/// distance to its embedded third-order solution, so its fourth-order solution is well within
-/// the tolerance; the BDF's estimate is its own solution's error. At a tenth of the tolerance
-/// the BDF's steps are as accurate as RODAS4's: on the main job's grid the worst maximum
-/// contact force of a whirl (stepped by the BDF) is 4.7e-4 from `reference` against RODAS4's
-/// 5.0e-4; at the same tolerance it was 2.1e-3, outside the budget, and at a third 8.2e-4
-/// (docs/performance.md#rodas4-then-bdf-model-version-12).
+/// The BDF's tolerances, as a fraction of the stepper's. A system's widened tolerances
+/// ([`OdeSystem::loosened_atol`]) stay what the system makes them: in a drop the race's
+/// velocity in contact, `rtol F_n / max(c1, c2)` from the scene's rtol. RODAS4's error
+/// estimate is the distance to its embedded third-order solution, so its fourth-order
+/// solution is well within the tolerance; the BDF's estimate is its own solution's error. At
+/// a tenth of the tolerance the BDF's steps are as accurate as RODAS4's: on the main job's
+/// grid the worst maximum contact force of a whirl (stepped by the BDF) is 4.7e-4 from
+/// `reference` against RODAS4's 5.0e-4; at the same tolerance it was 2.1e-3, outside the
+/// budget, and at a third 8.2e-4 (docs/performance.md#rodas4-then-bdf-model-version-12).
 pub const BDF_TOLERANCE: f64 = 0.1;
 /// The BDF's order when it takes over.
 const SEED_ORDER: usize = 3;
@@ -68,6 +70,8 @@ pub struct Rodas4Bdf<const N: usize> {
     /// Whether the next restart keeps the history
     /// ([`Stepper::keep_history_at_next_restart`]).
     keep_history: bool,
+    /// Step attempts of both methods together before a budget error.
+    budget: u64,
 }
 
 impl<const N: usize> Rodas4Bdf<N> {
@@ -87,6 +91,7 @@ impl<const N: usize> Rodas4Bdf<N> {
             t_restart: 0.0,
             handovers: 0,
             keep_history: false,
+            budget: ctl.max_attempts,
         }
     }
 
@@ -122,6 +127,20 @@ impl<const N: usize> Rodas4Bdf<N> {
         std::array::from_fn(|i| h00 * y0[i] + h10 * h * f0[i] + h01 * y1[i] + h11 * h * f1[i])
     }
 
+    /// `e`, with a step budget's attempts counted over both methods.
+    fn counting_both(&self, e: SolveError) -> SolveError {
+        match e {
+            SolveError::StepBudget { t_s, .. } => {
+                let s = self.stats();
+                SolveError::StepBudget {
+                    t_s,
+                    attempts: s.steps + s.rejected,
+                }
+            }
+            e => e,
+        }
+    }
+
     /// Hands over to the BDF if RODAS4 has run long enough since the restart, before a step
     /// (so that the step the driver saw last stays RODAS4's, with its interpolant).
     fn maybe_hand_over<S: OdeSystem<N>>(&mut self, sys: &S) {
@@ -154,9 +173,9 @@ impl<const N: usize> Stepper<N> for Rodas4Bdf<N> {
         if std::mem::take(&mut self.keep_history) {
             match self.phase {
                 // The BDF goes on with its differences.
-                Phase::Bdf if self.bdf.d0() == y => return,
+                Phase::Bdf if self.bdf.continues_at(t, y) => return,
                 // RODAS4 takes the derivative anew and keeps its count towards the hand-over.
-                Phase::Rodas if self.history.last().is_some_and(|h| h.1 == *y) => {
+                Phase::Rodas if self.history.last().is_some_and(|h| h.0 == t && h.1 == *y) => {
                     self.rodas.restart(sys, t, y);
                     self.history.last_mut().expect("checked").2 = self.rodas.f0;
                     return;
@@ -166,7 +185,7 @@ impl<const N: usize> Stepper<N> for Rodas4Bdf<N> {
         }
         if self.phase == Phase::Bdf {
             // RODAS4 goes on from the BDF's step size.
-            self.rodas.core_mut().h = self.bdf.core.h;
+            self.rodas.core_mut().h = self.bdf.next_step_size();
         }
         self.phase = Phase::Rodas;
         self.rodas.restart(sys, t, y);
@@ -186,10 +205,22 @@ impl<const N: usize> Stepper<N> for Rodas4Bdf<N> {
         if self.phase == Phase::Rodas {
             self.maybe_hand_over(sys);
         }
+        // One budget of step attempts for both methods together: each may use what the other
+        // left, and a budget error counts them all.
+        let (a, b) = (self.rodas.stats(), self.bdf.stats());
+        let used = [a.steps + a.rejected, b.steps + b.rejected];
         if self.phase == Phase::Bdf {
-            return self.bdf.step(sys, t, y, h_cap);
+            self.bdf.core.ctl.max_attempts = self.budget.saturating_sub(used[0]);
+            if let Err(e) = self.bdf.step(sys, t, y, h_cap) {
+                return Err(self.counting_both(e));
+            }
+            return Ok(&self.bdf.core.dense);
         }
-        let d = self.rodas.step(sys, t, y, h_cap)?;
+        self.rodas.core_mut().ctl.max_attempts = self.budget.saturating_sub(used[1]);
+        if let Err(e) = self.rodas.step(sys, t, y, h_cap) {
+            return Err(self.counting_both(e));
+        }
+        let d = self.rodas.last_dense();
         let end = (d.t1(), d.y1());
         if self.history.len() == HISTORY {
             self.history.remove(0);

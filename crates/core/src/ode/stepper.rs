@@ -1,14 +1,17 @@
-//! The interface the driver steps through: an adaptive one-step method with dense output.
+//! The interface the driver steps through: an adaptive method with dense output (a one-step
+//! method, or the multistep BDF, which keeps its history from step to step).
 
 use super::control::StepCore;
 use super::step::{Dense, Stats};
 use super::system::OdeSystem;
 use crate::error::SolveError;
 
-/// An adaptive one-step method with dense output, as [`super::integrate`] drives it.
+/// An adaptive method with dense output, as [`super::integrate`] drives it.
 pub trait Stepper<const N: usize> {
     /// Evaluates the derivative at `(t, y)` (a clean restart after a mode switch) and, on
-    /// the first call, picks an initial step.
+    /// the first call, picks an initial step. After [`Stepper::keep_history_at_next_restart`]
+    /// a stepper with a history may keep it instead, when `(t, y)` is where its last step
+    /// ended.
     fn restart<S: OdeSystem<N>>(&mut self, sys: &S, t: f64, y: &[f64; N]);
     /// Takes one accepted step from `(t, y)` of at most `h_cap`, retrying rejected attempts.
     fn step<S: OdeSystem<N>>(
