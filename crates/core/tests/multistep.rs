@@ -147,3 +147,48 @@ fn an_announced_restart_keeps_the_bdf_only_where_its_last_step_ended() {
     bdf.restart(&HARMONIC, t, &y);
     assert_eq!(bdf.order(), 1, "not kept after a step cut to 1e-12 s");
 }
+
+#[test]
+fn a_cap_after_a_jump_holds_though_the_last_step_was_cut_by_the_end_time() {
+    // As the drop does after a mode switch: cap the next step, then restart. The last step
+    // before it was shortened to the end time, so the step proposed before that cut is
+    // larger than the cap; the cap wins.
+    fn check<M: Stepper<2>>(name: &str, mut st: M) {
+        let (mut t, mut y) = (0.0, [1.0, 0.0]);
+        integrate(&HARMONIC, &mut st, &mut t, &mut y, 20.0, &mut NoObserver).unwrap();
+        let cap = 1e-6;
+        st.cap_next_step(cap);
+        st.restart(&HARMONIC, t, &y);
+        let dense = st.step(&HARMONIC, t, &y, f64::INFINITY).unwrap();
+        // (t1 - t0 at t = 20 carries rounding of some 1e-15 s.)
+        let h = dense.t1() - dense.t0();
+        assert!(
+            h <= cap * (1.0 + 1e-6),
+            "{name}: first step {h:e} after a cap of {cap:e}"
+        );
+    }
+    check("BDF", Bdf::new(ctl(1e-8, 1_000_000)));
+    check("RODAS4 then BDF", Rodas4Bdf::new(ctl(1e-8, 1_000_000)));
+}
+
+#[test]
+fn a_kept_history_needs_the_state_bit_for_bit() {
+    // At rest at the origin the state stays (0, 0) exactly. (-0.0, 0.0) compares equal to
+    // it but is another state's bits: an announced restart there starts afresh (with the
+    // history kept, the next step, which checks its state bit for bit under debug
+    // assertions, would refuse it).
+    let (mut t, mut y) = (0.0, [0.0, 0.0]);
+    let mut bdf = Bdf::new(ctl(1e-8, 1_000_000));
+    integrate(&HARMONIC, &mut bdf, &mut t, &mut y, 1.0, &mut NoObserver).unwrap();
+    assert_eq!(y, [0.0, 0.0]);
+    let flipped = [-0.0, 0.0];
+    bdf.keep_history_at_next_restart();
+    bdf.restart(&HARMONIC, t, &flipped);
+    bdf.step(&HARMONIC, t, &flipped, f64::INFINITY).unwrap();
+    let mut st = Rodas4Bdf::new(ctl(1e-8, 1_000_000));
+    let (mut t, mut y) = (0.0, [0.0, 0.0]);
+    integrate(&HARMONIC, &mut st, &mut t, &mut y, 1.0, &mut NoObserver).unwrap();
+    st.keep_history_at_next_restart();
+    st.restart(&HARMONIC, t, &flipped);
+    st.step(&HARMONIC, t, &flipped, f64::INFINITY).unwrap();
+}

@@ -27,10 +27,10 @@
 //! **One iteration where one is enough.** With the exact Jacobian at the starting point,
 //! Newton's iteration converges quadratically: the correction after the first one is about
 //! `K |dy_1|^2`. The constant `K` is measured on every attempt that iterates twice; while a
-//! measurement at most [`RECHECK_STEPS`] steps old, made since the last restart (in a drop:
-//! in the same mode), predicts the second correction below the iteration's tolerance, the
-//! first iteration ends it. On the pendulum drop the second
-//! correction is some 1e-4 of the first, far below the tolerance.
+//! measurement at most [`RECHECK_STEPS`] steps old, made since the last full restart (in a
+//! drop: in the same mode; a restart that keeps the history keeps it too), predicts the
+//! second correction below the iteration's tolerance, the first iteration ends it. On the
+//! pendulum drop the second correction is some 1e-4 of the first, far below the tolerance.
 //!
 //! What it costs: after every restart it starts again at order 1 from a short step, so a
 //! drop with many mode switches takes many low-order steps (see [`super::Rodas4Bdf`], which
@@ -70,6 +70,12 @@ const fn gammas() -> [f64; MAX_ORDER + 2] {
     g
 }
 const GAMMA: [f64; MAX_ORDER + 2] = gammas();
+
+/// Whether two states are equal bit for bit (`-0.0` is not `0.0`, a NaN equals itself): the
+/// test a history kept across a restart must pass.
+pub(super) fn same_bits<const N: usize>(a: &[f64; N], b: &[f64; N]) -> bool {
+    a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
 
 /// The error constant of order `k` in units of `nabla^{k+1} y`: `1 / (k + 1)`.
 #[inline]
@@ -211,7 +217,7 @@ impl<const N: usize> Bdf<N> {
         // Differences spaced by a step cut far below the one proposed (to femtoseconds, at
         // worst, by an end time) are not a history to go on from.
         let cut_short = self.last_capped && self.core.h < 0.1 * self.proposal;
-        !cut_short && self.core.h > 0.0 && self.core.dense.t_end == t && self.d[0] == *y
+        !cut_short && self.core.h > 0.0 && self.core.dense.t_end == t && same_bits(&self.d[0], y)
     }
 
     /// The step size a restart should start from: the current one, or the one proposed before
@@ -370,9 +376,13 @@ impl<const N: usize> Stepper<N> for Bdf<N> {
     }
 
     fn cap_next_step(&mut self, h_s: f64) {
-        if self.core.ctl.fixed_step.is_none() && self.core.h > h_s {
-            let factor = h_s / self.core.h;
-            self.rescale(factor);
+        if self.core.ctl.fixed_step.is_none() {
+            if self.core.h > h_s {
+                let factor = h_s / self.core.h;
+                self.rescale(factor);
+            }
+            // The step size a restart takes ([`Bdf::next_step_size`]) obeys the cap too.
+            self.proposal = self.proposal.min(h_s);
         }
     }
 
@@ -385,10 +395,7 @@ impl<const N: usize> Stepper<N> for Bdf<N> {
     ) -> Result<&Dense<N>, SolveError> {
         // Bitwise, so that a state that is not finite (which fails below) passes.
         debug_assert!(
-            self.d[0]
-                .iter()
-                .zip(y)
-                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            same_bits(&self.d[0], y),
             "the BDF stepper continues only from its own last step"
         );
         self.core.begin_step(sys, t, y);
@@ -397,9 +404,9 @@ impl<const N: usize> Stepper<N> for Bdf<N> {
         let fixed = self.core.ctl.fixed_step.is_some();
         // SciPy's (and RADAU5's) stopping tolerance of the Newton iteration.
         let newton_tol = (ROUNDING / rtol).max(0.03_f64.min(rtol.sqrt()));
-        // A step size that is not finite comes only from a state that is not (the first
-        // step's heuristic on NaN): fail at once rather than halve it to no end.
-        if !self.core.h.is_finite() {
+        // A state that is not finite, or a step size that is not (the first step's heuristic
+        // on such a state), fails at once rather than halving the step to no end.
+        if !self.core.h.is_finite() || !y.iter().all(|v| v.is_finite()) {
             return Err(SolveError::NonFiniteState { t_s: t });
         }
         // A step shortened to the cap (an end time) re-spaces the differences to it; the step
@@ -410,6 +417,7 @@ impl<const N: usize> Stepper<N> for Bdf<N> {
             self.rescale(h_cap / self.core.h);
             self.core.h = h_cap;
         }
+        let mut rejected = false;
         let (y_new, d_new, error_norm, safety) = loop {
             let attempts = self.core.stats.steps + self.core.stats.rejected;
             if attempts >= self.core.ctl.max_attempts {
@@ -445,6 +453,7 @@ impl<const N: usize> Stepper<N> for Bdf<N> {
                     return Err(SolveError::NonFiniteState { t_s: t });
                 }
                 self.core.stats.rejected += 1;
+                rejected = true;
                 self.rescale(0.5);
                 continue;
             };
@@ -456,6 +465,7 @@ impl<const N: usize> Stepper<N> for Bdf<N> {
             let error_norm = scaled_norm(error_constant(order), &d, &atol, rtol, &y_new);
             if !fixed && !(error_norm <= 1.0) {
                 self.core.stats.rejected += 1;
+                rejected = true;
                 let factor = if error_norm.is_finite() {
                     (safety * error_norm.powf(-1.0 / (order as f64 + 1.0))).max(MIN_FACTOR)
                 } else {
@@ -468,7 +478,9 @@ impl<const N: usize> Stepper<N> for Bdf<N> {
         };
         let h = self.core.h;
         let order = self.order;
-        self.last_capped = capped;
+        // A capped step that was rejected and shrunk says nothing for the proposal before
+        // the cap (as in the one-step methods' control).
+        self.last_capped = capped && !rejected;
         self.n_equal += 1;
         self.newton_k_age += 1;
         // The differences of the new step: nabla^{k+1} y_{n+1} = d, then downwards.

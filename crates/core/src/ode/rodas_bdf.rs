@@ -14,10 +14,10 @@
 //! Jacobian, one factorisation and one or two solves, against RODAS4's six, one, one and six;
 //! at a tenth of the tolerance ([`BDF_TOLERANCE`]) it takes about as many steps as RODAS4
 //! and is as close to `reference`. Started after each switch at order 1, the BDF alone missed
-//! the accuracy budget at rtol 3e-5 by up to sixteen times on the impacts of a bouncing
+//! the accuracy budget at rtol 3e-5 by up to fourteen times on the impacts of a bouncing
 //! sequence (docs/accuracy.md#model-version-12-rodas4-then-bdf).
 
-use super::bdf::{Bdf, MAX_ORDER};
+use super::bdf::{same_bits, Bdf, MAX_ORDER};
 use super::control::StepCore;
 use super::rodas::Rodas4;
 use super::step::{Dense, Stats, StepControl};
@@ -175,7 +175,12 @@ impl<const N: usize> Stepper<N> for Rodas4Bdf<N> {
                 // The BDF goes on with its differences.
                 Phase::Bdf if self.bdf.continues_at(t, y) => return,
                 // RODAS4 takes the derivative anew and keeps its count towards the hand-over.
-                Phase::Rodas if self.history.last().is_some_and(|h| h.0 == t && h.1 == *y) => {
+                Phase::Rodas
+                    if self
+                        .history
+                        .last()
+                        .is_some_and(|h| h.0 == t && same_bits(&h.1, y)) =>
+                {
                     self.rodas.restart(sys, t, y);
                     self.history.last_mut().expect("checked").2 = self.rodas.f0;
                     return;
@@ -242,6 +247,15 @@ impl<const N: usize> Stepper<N> for Rodas4Bdf<N> {
             Phase::Bdf => &mut self.bdf.core,
         }
     }
+    /// Caps the next step of the method in use: the BDF re-spaces its differences and caps
+    /// the step size a restart hands to RODAS4 as well.
+    fn cap_next_step(&mut self, h_s: f64) {
+        match self.phase {
+            Phase::Rodas => self.rodas.cap_next_step(h_s),
+            Phase::Bdf => self.bdf.cap_next_step(h_s),
+        }
+    }
+
     fn keep_history_at_next_restart(&mut self) {
         self.keep_history = true;
     }
