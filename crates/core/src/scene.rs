@@ -121,13 +121,12 @@ pub struct SolverSettings {
     pub max_step_attempts: u64,
     /// Located mode switches before a typed budget error (chatter guard). Default 2 000 000.
     pub max_events: u64,
-    /// The integrator. Default `rodas4_bdf` (the `standard` fidelity's): RODAS4
-    /// after each mode switch, which takes the impacts, and the variable-order BDF once the
-    /// contact has run smoothly for 2 ms (docs/model.md#integrator); `rodas4`, the
-    /// 4th-order Rosenbrock method on the model's full Jacobian, whose step is not bounded by
-    /// the light race's contact modes (the `draft` fidelity's, and the default until model
-    /// version 11); `bdf`, the BDF
-    /// alone; `dopri5`, the explicit Dormand-Prince 5(4) pair (the `reference` fidelity's);
+    /// The integrator. Default `rodas4_bdf` (the `standard` fidelity's): RODAS4 after each
+    /// mode switch, which takes the impacts, and the variable-order BDF once the contact has
+    /// run smoothly for 2 ms (docs/model.md#integrator); `rodas4`, the 4th-order Rosenbrock
+    /// method on the model's full Jacobian, whose step is not bounded by the light race's
+    /// contact modes (the `draft` fidelity's, and the default until model version 11);
+    /// `bdf`, the BDF alone; `dopri5`, the explicit Dormand-Prince 5(4) pair (the `reference` fidelity's);
     /// `ros34pw2`, the 3rd-order Rosenbrock-W method; `dop853` the independent reference of
     /// `whirlmap accuracy`; `rodas5p`, the 5th-order Rosenbrock method on RODAS4's Jacobian,
     /// for errors below about 1e-5 (docs/accuracy.md); `radau5`, the 5th-order Radau IIA
