@@ -74,7 +74,7 @@ struct Case {
 /// ratio to the baseline (the first row) and to the peer, and the work counts.
 pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
     let reps = a.reps;
-    let cases: [Case; 17] = [
+    let cases: [Case; 19] = [
         Case {
             name: "pendulum 1 s, standard (baseline)",
             speed_rpm: 8000.0,
@@ -133,6 +133,19 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
             speed_rpm: 8000.0,
             mu: 0.1,
             edit: |s| s.solver.method = whirlmap_core::Method::Bdf,
+        },
+        // The NDF in place of the BDF (docs/performance.md#the-ndf-measured).
+        Case {
+            name: "pendulum 1 s, rodas4 then ndf",
+            speed_rpm: 8000.0,
+            mu: 0.1,
+            edit: |s| s.solver.method = whirlmap_core::Method::Rodas4Ndf,
+        },
+        Case {
+            name: "whirl, rodas4 then ndf",
+            speed_rpm: 8000.0,
+            mu: 0.4,
+            edit: |s| s.solver.method = whirlmap_core::Method::Rodas4Ndf,
         },
         Case {
             name: "pendulum 1 s, radial-only damper",

@@ -1,7 +1,7 @@
 //! Ad-hoc diagnostic: accepted steps of a 1 s drop per 50 ms window and per mode (free,
 //! sticking, slipping), to see where a stepper spends its steps.
 //! `cargo run --release -p whirlmap-core --example steps -- [rtol=1e-4] [ros=true]
-//! [gap=true] [iso=true] [race=1000] [mu=0.1] [rpm=8000]`.
+//! [hyb=true] [ndf=true] [bdf=true] [gap=true] [radial=true] [race=1000] [mu=0.1] [rpm=8000]`.
 use std::convert::Infallible;
 use std::ops::ControlFlow;
 use whirlmap_core::ode::{Observer, StepView};
@@ -10,6 +10,8 @@ struct Rec(
     Vec<(f64, f64, bool, i32, u64)>,
     model::ModelEvals,
     Vec<(f64, f64, f64)>,
+    /// Accepted multistep steps per order (index 0: one-step methods' steps).
+    [u64; 6],
 );
 impl Observer<model::DropSystem, { model::N }> for Rec {
     type Halt = Infallible;
@@ -37,6 +39,7 @@ impl Observer<model::DropSystem, { model::N }> for Rec {
                 .push((s.dense.t0(), s.dense.t1() - s.dense.t0(), cap));
         }
         self.1 = sys.model_evals();
+        self.3[s.dense.multistep_order().unwrap_or(0)] += 1;
         ControlFlow::Continue(())
     }
 }
@@ -67,13 +70,18 @@ fn main() {
                     s.solver.method = scene::Method::Rodas4Bdf
                 }
             }
+            "ndf" => {
+                if v == "true" {
+                    s.solver.method = scene::Method::Rodas4Ndf
+                }
+            }
             "race" => s.solver.race_atol_scale = v.parse().unwrap(),
             "mu" => s.mu_dynamic = v.parse().unwrap(),
             "rpm" => s.speed_rpm = v.parse().unwrap(),
             _ => panic!("{k}"),
         }
     }
-    let mut rec = Rec(Vec::new(), Default::default(), Vec::new());
+    let mut rec = Rec(Vec::new(), Default::default(), Vec::new(), [0; 6]);
     let r = simulate_observed(
         &s,
         &DropOptions {
@@ -85,6 +93,11 @@ fn main() {
     .unwrap();
     println!("{:?} stop: {:?}", r.stats, r.stop_reason);
     println!("model evaluations: {:?}", rec.1);
+    println!(
+        "steps: one-step {}, multistep at orders 1-5 {:?}",
+        rec.3[0],
+        &rec.3[1..]
+    );
     let mut w = [[0usize; 5]; 20];
     let mut prev = 0u64;
     for &(t0, _t1, c, sl, ev) in &rec.0 {

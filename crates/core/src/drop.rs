@@ -509,6 +509,10 @@ pub fn simulate_observed<O: Observer<DropSystem, N>>(
         Method::Radau5 => run_with(scene, opts, extra, sys, crate::ode::Radau5::new(ctl)),
         Method::Bdf => run_with(scene, opts, extra, sys, crate::ode::Bdf::new(ctl)),
         Method::Rodas4Bdf => run_with(scene, opts, extra, sys, crate::ode::Rodas4Bdf::new(ctl)),
+        Method::Rodas4Ndf => {
+            let st = crate::ode::Rodas4Bdf::with_formula(ctl, crate::ode::Formula::Ndf);
+            run_with(scene, opts, extra, sys, st)
+        }
     }
 }
 

@@ -3,7 +3,7 @@
 //! the end time is not an underflow, a state that is not finite fails at once, and a restart
 //! announced as no mode switch keeps the history only where the last step ended.
 
-use whirlmap_core::ode::{integrate, Bdf, NoObserver, Rodas4Bdf, StepControl, Stepper};
+use whirlmap_core::ode::{integrate, Bdf, Formula, NoObserver, Rodas4Bdf, StepControl, Stepper};
 use whirlmap_core::SolveError;
 
 mod common;
@@ -69,6 +69,10 @@ fn a_step_cut_short_only_by_the_end_time_is_not_an_underflow() {
     }
     check("BDF", Bdf::new(ctl(1e-7, 1_000_000)));
     check("RODAS4 then BDF", Rodas4Bdf::new(ctl(1e-7, 1_000_000)));
+    check(
+        "RODAS4 then NDF",
+        Rodas4Bdf::with_formula(ctl(1e-7, 1_000_000), Formula::Ndf),
+    );
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! One harness for the steppers' order and tolerance: every stepper (DOPRI5, DOP853,
-//! ROS34PW2, RODAS4, Rodas5P, RADAU5; the multistep BDF and RODAS4 then BDF in the adaptive
-//! tests only) runs a set of reference problems with closed-form solutions, and for each the
-//! harness checks
+//! ROS34PW2, RODAS4, Rodas5P, RADAU5; the multistep BDF and NDF, and RODAS4 then either, in
+//! the adaptive tests only) runs a set of reference problems with closed-form solutions, and
+//! for each the harness checks
 //!
 //! - the observed convergence order on fixed steps (the error of `h` against `h / 2`) is the
 //!   order of the method's stability function (these problems are linear: its order, or
@@ -18,8 +18,8 @@
 //! midpoints. The observed orders and slopes print with `--nocapture`.
 
 use whirlmap_core::ode::{
-    integrate, Bdf, Dop853, Dopri5, NoGuard, NoObserver, OdeSystem, Radau5, Rodas4, Rodas4Bdf,
-    Rodas5p, Ros34pw2, StepControl, Stepper, StiffJacobian, Stop,
+    integrate, Bdf, Dop853, Dopri5, Formula, NoGuard, NoObserver, OdeSystem, Radau5, Rodas4,
+    Rodas4Bdf, Rodas5p, Ros34pw2, StepControl, Stepper, StiffJacobian, Stop,
 };
 
 mod common;
@@ -180,8 +180,9 @@ struct Method {
     /// How far the measured slope may be from `tol_slope`.
     slope_margin: f64,
     /// Whether it is a one-step method, whose order the fixed-step tests measure. The
-    /// multistep BDF and RODAS4 then BDF change their order as they go (the BDF's orders on
-    /// fixed steps are tested in `ode/bdf.rs`), so only their adaptive runs are tested here.
+    /// multistep BDF and NDF, and RODAS4 then either, change their order as they go (their
+    /// orders on fixed steps are tested in `ode/bdf.rs`), so only their adaptive runs are
+    /// tested here.
     one_step: bool,
 }
 
@@ -244,7 +245,7 @@ impl<M: Stepper<2>> StepperBox for M {
     }
 }
 
-fn methods() -> [Method; 8] {
+fn methods() -> [Method; 10] {
     [
         Method {
             name: "DOPRI5",
@@ -353,6 +354,34 @@ fn methods() -> [Method; 8] {
             implicit: true,
             w_method: false,
             // RODAS4's slope (1) where it steps, the BDF's (0.5 to 0.83) once it takes over.
+            tol_slope: 0.8,
+            slope_margin: 0.25,
+            one_step: false,
+        },
+        Method {
+            name: "NDF",
+            order: 5.0,
+            linear_order: 5.0,
+            make: |c| Box::new(Bdf::with_formula(c, Formula::Ndf)),
+            steps: 0,
+            rtols: [1e-4, 1e-6, 1e-8],
+            implicit: true,
+            w_method: false,
+            // As the BDF's: its estimate is its own solution's error at order k.
+            tol_slope: 0.7,
+            slope_margin: 0.2,
+            one_step: false,
+        },
+        Method {
+            name: "RODAS4 then NDF",
+            order: 4.0,
+            linear_order: 4.0,
+            make: |c| Box::new(Rodas4Bdf::with_formula(c, Formula::Ndf)),
+            steps: 0,
+            rtols: [1e-4, 1e-6, 1e-8],
+            implicit: true,
+            w_method: false,
+            // As RODAS4 then BDF's.
             tol_slope: 0.8,
             slope_margin: 0.25,
             one_step: false,
@@ -711,6 +740,10 @@ fn every_stepper_asks_for_the_tolerances_at_each_steps_start_and_uses_them() {
     run("RADAU5", Radau5::new);
     run("BDF", Bdf::new);
     run("RODAS4 then BDF", Rodas4Bdf::new);
+    run("NDF", |c| Bdf::with_formula(c, Formula::Ndf));
+    run("RODAS4 then NDF", |c| {
+        Rodas4Bdf::with_formula(c, Formula::Ndf)
+    });
 }
 
 /// The largest error of a step's interpolant at its midpoint, over a run of [`Logistic`].

@@ -288,6 +288,7 @@ fn implicit_steppers_converge_to_the_reference_on_a_bouncing_drop() {
         Method::Rodas5p,
         Method::Radau5,
         Method::Rodas4Bdf,
+        Method::Rodas4Ndf,
     ] {
         converges_to(&reference, method);
     }

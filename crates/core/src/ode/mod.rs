@@ -23,7 +23,7 @@ mod step;
 mod stepper;
 mod system;
 
-pub use bdf::Bdf;
+pub use bdf::{Bdf, Formula};
 pub use control::StepCore;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;

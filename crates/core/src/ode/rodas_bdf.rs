@@ -17,7 +17,7 @@
 //! the accuracy budget at rtol 3e-5 by up to fourteen times on the impacts of a bouncing
 //! sequence (docs/accuracy.md#model-version-12-rodas4-then-bdf).
 
-use super::bdf::{same_bits, Bdf, MAX_ORDER};
+use super::bdf::{same_bits, Bdf, Formula, MAX_ORDER};
 use super::control::StepCore;
 use super::rodas::Rodas4;
 use super::step::{Dense, Stats, StepControl};
@@ -52,7 +52,8 @@ enum Phase {
     Bdf,
 }
 
-/// RODAS4 after each restart, the BDF in long smooth stretches (see the module doc).
+/// RODAS4 after each restart, the BDF (or the NDF) in long smooth stretches (see the module
+/// doc).
 #[derive(Debug, Clone)]
 pub struct Rodas4Bdf<const N: usize> {
     rodas: Rodas4<N>,
@@ -65,7 +66,7 @@ pub struct Rodas4Bdf<const N: usize> {
     since_restart: usize,
     /// Time of the last restart (s).
     t_restart: f64,
-    /// Hand-overs to the BDF so far.
+    /// Hand-overs to the BDF (or NDF) so far.
     handovers: u64,
     /// Whether the next restart keeps the history
     /// ([`Stepper::keep_history_at_next_restart`]).
@@ -75,16 +76,26 @@ pub struct Rodas4Bdf<const N: usize> {
 }
 
 impl<const N: usize> Rodas4Bdf<N> {
-    /// A stepper with the given control settings and no step-size history.
+    /// A stepper with the given control settings and no step-size history, whose multistep
+    /// method is the BDF.
     pub fn new(ctl: StepControl<N>) -> Self {
+        Self::with_formula(ctl, Formula::Bdf)
+    }
+
+    /// As [`Rodas4Bdf::new`], with the multistep method's formulas given: the BDF or the NDF
+    /// ([`Formula`]; `solver.method = "rodas4_ndf"` in a scene).
+    pub fn with_formula(ctl: StepControl<N>, formula: Formula) -> Self {
         const { assert!(SEED_ORDER <= MAX_ORDER && SEED_ORDER < HISTORY) };
         Self {
             rodas: Rodas4::new(ctl),
-            bdf: Bdf::new(StepControl {
-                rtol: ctl.rtol * BDF_TOLERANCE,
-                atol: ctl.atol.map(|a| a * BDF_TOLERANCE),
-                ..ctl
-            }),
+            bdf: Bdf::with_formula(
+                StepControl {
+                    rtol: ctl.rtol * BDF_TOLERANCE,
+                    atol: ctl.atol.map(|a| a * BDF_TOLERANCE),
+                    ..ctl
+                },
+                formula,
+            ),
             phase: Phase::Rodas,
             history: Vec::with_capacity(HISTORY),
             since_restart: 0,
@@ -95,12 +106,12 @@ impl<const N: usize> Rodas4Bdf<N> {
         }
     }
 
-    /// Hand-overs to the BDF so far.
+    /// Hand-overs to the BDF (or NDF) so far.
     pub fn handovers(&self) -> u64 {
         self.handovers
     }
 
-    /// Accepted steps the BDF took so far (the rest of [`Stepper::stats`]' steps are
+    /// Accepted steps the BDF (or NDF) took so far (the rest of [`Stepper::stats`]' steps are
     /// RODAS4's).
     pub fn bdf_steps(&self) -> u64 {
         self.bdf.stats().steps

@@ -73,6 +73,11 @@ impl<const N: usize> Dense<N> {
     pub fn t1(&self) -> f64 {
         self.t_end
     }
+    /// The order of the multistep (BDF or NDF) step whose interpolant this is; `None` for a
+    /// one-step method's step.
+    pub fn multistep_order(&self) -> Option<usize> {
+        self.terms.checked_sub(BACKWARD)
+    }
     /// State at `t` (meant for `t` in `[t0, t1]`).
     #[inline]
     pub fn eval(&self, t: f64) -> [f64; N] {
