@@ -97,7 +97,7 @@ pub enum Formula {
     /// The backward differentiation formulas.
     Bdf,
     /// The numerical differentiation formulas of Klopfenstein, with Shampine and Reichelt's
-    /// `kappa` ([`NDF_KAPPA`]).
+    /// `kappa_k`: -0.1850, -1/9, -0.0823, -0.0415 and 0 at orders 1 to 5.
     Ndf,
 }
 
