@@ -15,6 +15,11 @@ W=target/release/whirlmap
 parts=("$@")
 [ ${#parts[@]} -eq 0 ] && parts=(paper radial reference physics nightly ensemble adaptive accuracy drops thermal life)
 
+# The accuracy studies, as OUTPUT:CASES (results/OUTPUT from sweeps/CASES.json).
+studies=(accuracy:accuracy-cases accuracy-radial:accuracy-radial accuracy-implicit:accuracy-implicit
+         accuracy-rodas4:accuracy-rodas4 accuracy-rodas5p:accuracy-rodas5p accuracy-draft:accuracy-draft
+         accuracy-bdf:accuracy-bdf)
+
 # `compare` exits 1 when the runs differ, which is the point of these comparisons.
 compare() { "$W" compare "$@" || [ $? -eq 1 ]; }
 
@@ -49,17 +54,13 @@ for part in "${parts[@]}"; do
         "$W" adaptive "sweeps/$s.json" --compare-full --no-progress
       done ;;
     accuracy)
-      for s in accuracy:accuracy-cases accuracy-radial:accuracy-radial accuracy-implicit:accuracy-implicit \
-               accuracy-rodas4:accuracy-rodas4 accuracy-rodas5p:accuracy-rodas5p accuracy-draft:accuracy-draft \
-               accuracy-bdf:accuracy-bdf; do
+      for s in "${studies[@]}"; do
         out=${s%%:*}; cases=${s##*:}
         rm -rf "results/$out"
         "$W" accuracy --cases "sweeps/$cases.json" --out "results/$out"
       done ;;
     accuracy-charts)
-      for s in accuracy:accuracy-cases accuracy-radial:accuracy-radial accuracy-implicit:accuracy-implicit \
-               accuracy-rodas4:accuracy-rodas4 accuracy-rodas5p:accuracy-rodas5p accuracy-draft:accuracy-draft \
-               accuracy-bdf:accuracy-bdf; do
+      for s in "${studies[@]}"; do
         out=${s%%:*}; cases=${s##*:}
         "$W" accuracy --cases "sweeps/$cases.json" --out "results/$out" --charts-only
       done ;;

@@ -492,14 +492,15 @@ impl<const N: usize> Stepper<N> for Bdf<N> {
                     y_pred[i] += self.d[j][i];
                 }
             }
+            let alpha = self.alpha(order);
             for j in 1..=order {
-                let w = GAMMA[j] / self.alpha(order);
+                let w = GAMMA[j] / alpha;
                 for i in 0..N {
                     psi[i] += w * self.d[j][i];
                 }
             }
             let scale: [f64; N] = std::array::from_fn(|i| atol[i] + rtol * y_pred[i].abs());
-            let c = h / self.alpha(order);
+            let c = h / alpha;
             let Attempt::Converged(y_new, d, iterations) =
                 self.attempt(sys, t + h, &y_pred, &psi, c, &scale, newton_tol)
             else {
