@@ -121,38 +121,67 @@ type Diffs<const N: usize> = [[f64; N]; MAX_ORDER + 3];
 
 /// The matrix `R(k, factor)` of the re-interpolation of the differences to a new spacing
 /// (Shampine and Reichelt, eq. 2.5): row 0 ones, then the cumulative products of
-/// `(i - 1 - factor j) / i`; zero outside rows and columns `0..=order`.
-fn interp_matrix(order: usize, factor: f64) -> [[f64; MAX_ORDER + 1]; MAX_ORDER + 1] {
+/// `(i - 1 - factor j) / i`; zero outside rows and columns `0..=order`. A `const fn`, so that
+/// [`U_TABLE`] is computed by the compiler, with the same IEEE operations as at run time.
+const fn interp_matrix(order: usize, factor: f64) -> [[f64; MAX_ORDER + 1]; MAX_ORDER + 1] {
     const INV: [f64; MAX_ORDER + 1] = [0.0, 1.0, 1.0 / 2.0, 1.0 / 3.0, 1.0 / 4.0, 1.0 / 5.0];
     let mut m = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
-    m[0][..=order].fill(1.0);
-    for i in 1..=order {
-        for j in 1..=order {
+    let mut j = 0;
+    while j <= order {
+        m[0][j] = 1.0;
+        j += 1;
+    }
+    let mut i = 1;
+    while i <= order {
+        let mut j = 1;
+        while j <= order {
             m[i][j] = m[i - 1][j] * ((i as f64 - 1.0 - factor * j as f64) * INV[i]);
+            j += 1;
         }
+        i += 1;
     }
     m
 }
 
+/// `U(k) = R(k, 1)` for every order `k`, computed once. Upper triangular: below the diagonal,
+/// row `j + 1` of column `j` takes the factor `(j - j) / (j + 1) = 0`, and the rows under it
+/// are its multiples.
+const U_TABLE: [[[f64; MAX_ORDER + 1]; MAX_ORDER + 1]; MAX_ORDER + 1] = {
+    let mut t = [[[0.0; MAX_ORDER + 1]; MAX_ORDER + 1]; MAX_ORDER + 1];
+    let mut k = 0;
+    while k <= MAX_ORDER {
+        t[k] = interp_matrix(k, 1.0);
+        k += 1;
+    }
+    t
+};
+
 /// Re-interpolates the differences of order `order` from spacing `h` to `factor h`:
 /// `D <- (R U)^T D` over rows `0..=order`, with `U = R(order, 1)`. Exact for a solution that
 /// is a polynomial of degree `order`. The rows above `order` are left as they are.
+///
+/// `U` comes from [`U_TABLE`], and `R U` leaves out `U`'s zeros below its diagonal. That
+/// changes no bit: each sum starts at `+0.0` and never holds `-0.0` (round to nearest gives a
+/// cancellation `+0.0`), so adding a product of `±0.0` to it would leave it as it is. Both
+/// together took this function's instructions on the 1 s pendulum drop from 7.73 M to 3.05 M
+/// (callgrind).
 fn change_spacing<const N: usize>(d: &mut Diffs<N>, order: usize, factor: f64) {
+    let n = order + 1;
     let r = interp_matrix(order, factor);
-    let u = interp_matrix(order, 1.0);
+    let u = &U_TABLE[order];
     let mut ru = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
-    for i in 0..=order {
-        for k in 0..=order {
+    for i in 0..n {
+        for k in 0..n {
             let rik = r[i][k];
-            for j in 0..=order {
+            for j in k..n {
                 ru[i][j] += rik * u[k][j];
             }
         }
     }
     let old = [d[0], d[1], d[2], d[3], d[4], d[5]];
-    for j in 0..=order {
+    for j in 0..n {
         let mut row = [0.0; N];
-        for (k, old_k) in old.iter().enumerate().take(order + 1) {
+        for (k, old_k) in old.iter().enumerate().take(n) {
             let w = ru[k][j];
             for i in 0..N {
                 row[i] += w * old_k[i];
@@ -658,6 +687,56 @@ mod tests {
                     d[j][i],
                     want[j][i]
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn re_interpolation_is_the_full_product_bit_for_bit() {
+        // `change_spacing` takes `U` from the table and leaves out its zeros; the product in
+        // full, with `U` computed here, must give the same bits, at every order and for
+        // factors that shrink and grow the step (and for differences of both signs, so that
+        // negative zeros would show).
+        for order in 1..=MAX_ORDER {
+            for factor in [0.2, 0.37, 0.5, 0.93, 1.0, 1.7, 10.0] {
+                let mut d: Diffs<3> = [[0.0; 3]; MAX_ORDER + 3];
+                for (j, row) in d.iter_mut().enumerate() {
+                    for (i, x) in row.iter_mut().enumerate() {
+                        *x = ((j * 7 + i * 3) as f64 * 0.731).sin() * 10f64.powi(-(j as i32));
+                    }
+                }
+                let mut full = d;
+                let r = interp_matrix(order, factor);
+                let u = interp_matrix(order, 1.0);
+                let mut ru = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
+                for i in 0..=order {
+                    for k in 0..=order {
+                        for j in 0..=order {
+                            ru[i][j] += r[i][k] * u[k][j];
+                        }
+                    }
+                }
+                let old = full;
+                for j in 0..=order {
+                    let mut row = [0.0; 3];
+                    for k in 0..=order {
+                        for i in 0..3 {
+                            row[i] += ru[k][j] * old[k][i];
+                        }
+                    }
+                    full[j] = row;
+                }
+                change_spacing(&mut d, order, factor);
+                for j in 0..MAX_ORDER + 3 {
+                    for i in 0..3 {
+                        assert!(
+                            d[j][i].to_bits() == full[j][i].to_bits(),
+                            "order {order}, factor {factor}, row {j}: {:e} against {:e}",
+                            d[j][i],
+                            full[j][i]
+                        );
+                    }
+                }
             }
         }
     }
