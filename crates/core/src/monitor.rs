@@ -325,6 +325,25 @@ struct Sample {
     heat_power: f64,
 }
 
+/// `x.rem_euclid(TAU)`, bit for bit, without its `fmod` call where `x` is in
+/// `(-TAU, 2 TAU)`, as the contact angle's increments always are: there `fmod` returns `x`
+/// itself (then `x + TAU` below zero, as `rem_euclid` adds) or `x - TAU`, which is exact
+/// (Sterbenz's lemma). A NaN passes through either way.
+#[inline]
+fn wrap_tau(x: f64) -> f64 {
+    if x > -TAU && x < 2.0 * TAU {
+        if x < 0.0 {
+            x + TAU
+        } else if x >= TAU {
+            x - TAU
+        } else {
+            x
+        }
+    } else {
+        x.rem_euclid(TAU)
+    }
+}
+
 fn sample(sys: &DropSystem, y: &[f64; N]) -> Sample {
     sys.with_forces(y, |f| Sample {
         normal: f.normal_n,
@@ -505,8 +524,8 @@ impl Monitor {
         // Angle from the bottom of the race, counter-clockwise positive.
         let raw = dy.atan2(dx) + 0.5 * PI;
         match self.angle_raw_prev {
-            None => self.angle = (raw + PI).rem_euclid(TAU) - PI,
-            Some(prev) => self.angle += (raw - prev + PI).rem_euclid(TAU) - PI,
+            None => self.angle = wrap_tau(raw + PI) - PI,
+            Some(prev) => self.angle += wrap_tau(raw - prev + PI) - PI,
         }
         self.angle_raw_prev = Some(raw);
         if self.angle_at_first_contact.is_some() {
@@ -725,7 +744,16 @@ impl Observer<DropSystem, N> for Monitor {
         let d = step.dense;
         let (t0, t1) = (d.t0(), d.t1());
         let tm = 0.5 * (t0 + t1);
-        let (y0, ym, y1) = (d.y0(), d.eval(tm), d.y1());
+        let (y0, y1) = (d.y0(), d.y1());
+        // The driver's midpoint value where it has one (the same bits as evaluating here).
+        let ym_here;
+        let ym = match step.midpoint {
+            Some(ym) => ym,
+            None => {
+                ym_here = d.eval(tm);
+                &ym_here
+            }
+        };
         let contact = sys.mode.contact;
         if contact {
             self.contact_s += t1 - t0;
@@ -742,7 +770,7 @@ impl Observer<DropSystem, N> for Monitor {
         // In free flight only the (smooth, slowly varying) bearing power is non-zero: its
         // step-end values suffice. In contact a midpoint sample brackets interior peaks.
         let sm = if contact {
-            sample(sys, &ym)
+            sample(sys, ym)
         } else if s0.heat_power >= s1.heat_power {
             s0
         } else {
@@ -750,7 +778,7 @@ impl Observer<DropSystem, N> for Monitor {
         };
         self.track_peaks(sys, d, [t0, tm, t1], [&s0, &sm, &s1]);
         self.prev_end = Some((t1, s1));
-        let angle_mid = self.track_angle(&ym, tm).then_some(self.angle);
+        let angle_mid = self.track_angle(ym, tm).then_some(self.angle);
         let angle_end = self.track_angle(&y1, t1).then_some(self.angle);
         self.bin_step(t0, t1, contact, angle_mid, angle_end);
         self.last_t = t1;
@@ -759,6 +787,25 @@ impl Observer<DropSystem, N> for Monitor {
             ControlFlow::Break(WhirlDecided)
         } else {
             ControlFlow::Continue(())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wrap_tau_is_rem_euclid_bit_for_bit() {
+        // The edges of the fast path and of each branch, their neighbours, and a sweep.
+        let mut xs = vec![-0.0, 0.0, TAU, -TAU, 2.0 * TAU, PI, -PI, 3.0 * PI, f64::NAN];
+        for e in [-TAU, 0.0, TAU, 2.0 * TAU] {
+            xs.extend([e.next_down(), e.next_up()]);
+        }
+        xs.extend((-4000..=4000).map(|i| i as f64 * 0.003_141_5));
+        for x in xs {
+            let (a, b) = (wrap_tau(x), x.rem_euclid(TAU));
+            assert!(a.to_bits() == b.to_bits(), "x {x:e}: {a:e} against {b:e}");
         }
     }
 }

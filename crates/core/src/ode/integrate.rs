@@ -12,6 +12,10 @@ use std::ops::ControlFlow;
 pub struct StepView<'a, const N: usize> {
     /// The step's interpolant over `[t0, t1]`.
     pub dense: &'a Dense<N>,
+    /// The interpolant's value at the step's midpoint `0.5 * (t0 + t1)`, where the driver
+    /// has evaluated it for the guards (bit for bit what `dense.eval` gives there); `None` on
+    /// a step cut at an event, whose midpoint the driver did not evaluate.
+    pub midpoint: Option<&'a [f64; N]>,
 }
 
 /// Receives every accepted step; may ask the integrator to stop, and says why.
@@ -99,7 +103,8 @@ where
         // is not missed; a crossing in the first half wins over one in the second.
         let tm = 0.5 * (dense.t0() + t1);
         let mut gm = [0.0; MAX_GUARDS];
-        sys.guards(tm, &dense.eval(tm), &mut gm);
+        let ym = dense.eval(tm);
+        sys.guards(tm, &ym, &mut gm);
         let guard_at = |i: usize, tt: f64| {
             let mut g = [0.0; MAX_GUARDS];
             sys.guards(tt, &dense.eval(tt), &mut g);
@@ -152,7 +157,10 @@ where
                     crossed[j] = j != index && crosses_from(g0[j], at_event[j]);
                     violated_before[j] = g0[j] < 0.0 && at_event[j] <= 0.0;
                 }
-                let view = StepView { dense: cut };
+                let view = StepView {
+                    dense: cut,
+                    midpoint: None,
+                };
                 // The observer sees the step up to the event; a break here is moot.
                 let _ = observer.on_step(sys, &view);
                 return Ok(Stop::Event {
@@ -167,6 +175,7 @@ where
                 g0 = g1;
                 let view = StepView {
                     dense: stepper.last_dense(),
+                    midpoint: Some(&ym),
                 };
                 if let ControlFlow::Break(halt) = observer.on_step(sys, &view) {
                     return Ok(Stop::Halted(halt));
