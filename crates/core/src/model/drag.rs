@@ -17,6 +17,15 @@ pub struct Palmgren {
     pub c0_n: f64,
 }
 
+/// The powers of the drag torque at one speed and load ([`Palmgren::powers`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DragPowers {
+    /// Eq. 12's `(nu0 n)^(2/3)`, `nu0` in mm^2/s and `n` in r/min.
+    pub nu0_n_pow_2_3: f64,
+    /// Eq. 13's load part `M_1` (N m).
+    pub load_torque_n_m: f64,
+}
+
 /// rad/s to r/min.
 const RAD_S_TO_RPM: f64 = 30.0 / std::f64::consts::PI;
 
@@ -64,9 +73,39 @@ impl Palmgren {
     /// low-speed constant (flat below it); eq. 13's M_1 as `load^1.33`. Each power is taken
     /// once: the torque has the bits of [`Palmgren::torque_n_m`].
     pub fn torque_and_slopes(&self, omega_rad_s: f64, load_n: f64) -> (f64, f64, f64) {
-        let x23 = self.nu0_n_pow_2_3(omega_rad_s);
+        self.torque_and_slopes_from(self.powers(omega_rad_s, load_n), omega_rad_s, load_n)
+    }
+
+    /// The two powers of the torque at `(omega_rad_s, load_n)`: eq. 12's `(nu0 n)^(2/3)` and
+    /// eq. 13's whole `M_1` (N m). [`Palmgren::torque_from`] and
+    /// [`Palmgren::torque_and_slopes_from`] take them, so that the force model's evaluation
+    /// and the Jacobian's at the same state take them once.
+    #[inline]
+    pub fn powers(&self, omega_rad_s: f64, load_n: f64) -> DragPowers {
+        DragPowers {
+            nu0_n_pow_2_3: self.nu0_n_pow_2_3(omega_rad_s),
+            load_torque_n_m: self.load_torque_n_m(load_n),
+        }
+    }
+
+    /// [`Palmgren::torque_n_m`] from [`Palmgren::powers`] at the same speed and load (the
+    /// same bits).
+    #[inline]
+    pub fn torque_from(&self, pw: DragPowers) -> f64 {
+        self.viscous_from_x23(pw.nu0_n_pow_2_3) + pw.load_torque_n_m
+    }
+
+    /// [`Palmgren::torque_and_slopes`] from [`Palmgren::powers`] at the same speed and load
+    /// (the same bits).
+    pub fn torque_and_slopes_from(
+        &self,
+        pw: DragPowers,
+        omega_rad_s: f64,
+        load_n: f64,
+    ) -> (f64, f64, f64) {
+        let x23 = pw.nu0_n_pow_2_3;
         let m0 = self.viscous_from_x23(x23);
-        let m1 = self.load_torque_n_m(load_n);
+        let m1 = pw.load_torque_n_m;
         let d_omega = if omega_rad_s != 0.0 && x23 > 160.0 {
             (2.0 / 3.0) * m0 / omega_rad_s
         } else {
@@ -145,6 +184,12 @@ mod tests {
                     0.001 * pow(p / b.c0_n, 0.33) * p * b.dm_mm * 1e-3
                 };
                 assert_eq!(m.to_bits(), (m0 + m1).to_bits());
+                // The force model's torque from the kept powers: torque_n_m's bits.
+                let pw = b.powers(omega, load);
+                assert_eq!(
+                    b.torque_from(pw).to_bits(),
+                    b.torque_n_m(omega, load).to_bits()
+                );
                 let old_dw = if omega != 0.0 && pow(x, 2.0 / 3.0) > 160.0 {
                     (2.0 / 3.0) * m0 / omega
                 } else {

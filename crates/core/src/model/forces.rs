@@ -36,6 +36,12 @@ pub struct Forces {
     pub support_raw_n: f64,
     /// Palmgren drag torque on the race (N m, signed, opposing omega_b).
     pub drag_torque_n_m: f64,
+    /// The drag torque's two powers at this state (zero without drag), kept for the
+    /// Jacobian at the same state.
+    pub drag_powers: drag::DragPowers,
+    /// `sign(delta) |delta|^e1`, the elastic term of eq. 7 at the rotor-race contact over its
+    /// stiffness (zero with the quasi-static race), kept for the Jacobian at the same state.
+    pub contact_pow: f64,
     /// H_s = F_t v_rel (W), eq. 17.
     pub friction_power_w: f64,
     /// Bearing drag power M |omega_b| (W): the bearing's share of eq. 14's H.
@@ -130,8 +136,9 @@ impl DropSystem {
             c_contact = self.c1 * w * w + self.c2 * (1.0 - w) * (1.0 - w);
             f.normal_raw_n = sp.force_n + c_contact * f.delta_dot_m_s;
         } else {
-            f.normal_raw_n =
-                hertz::raw_force(self.k1, self.e1, self.c1, f.delta_m, f.delta_dot_m_s);
+            // `hertz::raw_force`, with its power kept.
+            f.contact_pow = hertz::signed_pow(f.delta_m, self.e1);
+            f.normal_raw_n = self.k1 * f.contact_pow + self.c1 * f.delta_dot_m_s;
         }
         if mode.contact {
             f.normal_n = f.normal_raw_n;
@@ -168,7 +175,8 @@ impl DropSystem {
         // thermally induced load (exactly 0.0 without a thermal model, so no bit changes).
         let wb = y[ix::WB];
         if let Some(p) = &self.drag {
-            let m = p.torque_n_m(wb, f.support_n + self.thermal_load_n);
+            f.drag_powers = p.powers(wb, f.support_n + self.thermal_load_n);
+            let m = p.torque_from(f.drag_powers);
             let dir = drag::direction(wb, self.omega_eps);
             f.drag_torque_n_m = -m * dir;
             f.bearing_power_w = m * dir * wb;

@@ -87,8 +87,9 @@ impl DropSystem {
                 }
                 None => {
                     let d = f.delta_m.max(0.0);
+                    // `f.contact_pow` is `signed_pow(delta, e1)`, and `d` is `delta` here.
                     let kd = if d > 0.0 {
-                        self.k1 * self.e1 * hertz::signed_pow(d, self.e1) / d
+                        self.k1 * self.e1 * f.contact_pow / d
                     } else {
                         0.0
                     };
@@ -299,7 +300,7 @@ impl DropSystem {
         let p = self.drag.as_ref()?;
         let wb = y[ix::WB];
         let load = f.support_n + self.thermal_load_n;
-        let (m, dm_dw, dm_dload) = p.torque_and_slopes(wb, load);
+        let (m, dm_dw, dm_dload) = p.torque_and_slopes_from(f.drag_powers, wb, load);
         let (dir, ddir) = drag::direction_and_slope(wb, self.omega_eps);
         Some(DragSlopes {
             m,
