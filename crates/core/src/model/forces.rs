@@ -216,3 +216,62 @@ impl DropSystem {
         f.acc = self.accelerations(y, f, ft, support_vec);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{hertz, DropSystem};
+    use super::*;
+    use crate::Scene;
+
+    #[test]
+    fn kept_powers_are_the_powers_at_that_state() {
+        // The Jacobian reads `contact_pow` and `drag_powers` from the force model's evaluation
+        // at its own state and mode instead of taking the powers again, so they must have the
+        // bits of the powers taken afresh there: at the penetration, and at the race's spin and
+        // the drag's load (the support force plus a thermal load). In contact and out of it,
+        // in every slip mode, on and off the support, at speeds above and below eq. 12's
+        // switch.
+        let mut sys = DropSystem::new(&Scene::paper());
+        sys.thermal_load_n = 37.5;
+        let p = sys.drag.expect("the paper's scene has drag");
+        let s = sys.clearance_m();
+        let mut checked = 0;
+        for (gap_m, wb) in [(0.2e-6, 300.0), (-1e-6, 300.0), (0.5e-6, 0.05), (0.0, -40.0)] {
+            let mut y = [0.0; N];
+            y[ix::YB] = -3.7e-6;
+            y[ix::XR] = 0.4e-6;
+            y[ix::YR] = y[ix::YB] - (s + gap_m);
+            y[ix::VXR] = 0.01;
+            y[ix::VYR] = -0.02;
+            y[ix::VXB] = 0.003;
+            y[ix::WR] = 800.0;
+            y[ix::WB] = wb;
+            for contact in [true, false] {
+                for support in [true, false] {
+                    for slip in [Slip::Sticking, Slip::Slipping(1.0), Slip::Slipping(-1.0)] {
+                        let mode = Mode {
+                            contact,
+                            support,
+                            slip,
+                        };
+                        let f = sys.forces_in(&y, mode);
+                        let pow = hertz::signed_pow(f.delta_m, sys.e1);
+                        assert_eq!(f.contact_pow.to_bits(), pow.to_bits(), "{mode:?}");
+                        let fresh = p.powers(wb, f.support_n + sys.thermal_load_n);
+                        let kept = f.drag_powers;
+                        assert_eq!(
+                            (kept.nu0_n_pow_2_3.to_bits(), kept.load_torque_n_m.to_bits()),
+                            (fresh.nu0_n_pow_2_3.to_bits(), fresh.load_torque_n_m.to_bits()),
+                            "{mode:?}, race spin {wb}"
+                        );
+                        // Not a vacuous comparison: the powers are there.
+                        assert!(gap_m == 0.0 || pow != 0.0);
+                        assert!(!support || kept.load_torque_n_m > 0.0);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 48);
+    }
+}

@@ -160,7 +160,8 @@ const U_TABLE: [[[f64; MAX_ORDER + 1]; MAX_ORDER + 1]; MAX_ORDER + 1] = {
 /// `D <- (R U)^T D` over rows `0..=order`, with `U = R(order, 1)`. Exact for a solution that
 /// is a polynomial of degree `order`. The rows above `order` are left as they are.
 ///
-/// `U` comes from [`U_TABLE`], and `R U` leaves out `U`'s zeros below its diagonal. That
+/// `U` comes from [`U_TABLE`], and `R U` leaves out `U`'s zeros below its diagonal. For a
+/// finite `factor` (every caller's, in `(0, MAX_FACTOR]`), so that `R` is finite, that
 /// changes no bit: each sum starts at `+0.0` and never holds `-0.0` (round to nearest gives a
 /// cancellation `+0.0`), so adding a product of `±0.0` to it would leave it as it is. Both
 /// together took this function's instructions on the 1 s pendulum drop from 7.73 M to 3.05 M
