@@ -57,7 +57,9 @@ impl Observer<DropSystem, N> for Check {
             Some(ym) => {
                 let fresh = d.eval(tm);
                 assert!(
-                    ym.iter().zip(&fresh).all(|(a, b)| a.to_bits() == b.to_bits()),
+                    ym.iter()
+                        .zip(&fresh)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()),
                     "midpoint at t = {tm}: {ym:?} against {fresh:?}"
                 );
                 self.midpoint_given += 1;

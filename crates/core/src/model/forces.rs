@@ -236,7 +236,12 @@ mod tests {
         let p = sys.drag.expect("the paper's scene has drag");
         let s = sys.clearance_m();
         let mut checked = 0;
-        for (gap_m, wb) in [(0.2e-6, 300.0), (-1e-6, 300.0), (0.5e-6, 0.05), (0.0, -40.0)] {
+        for (gap_m, wb) in [
+            (0.2e-6, 300.0),
+            (-1e-6, 300.0),
+            (0.5e-6, 0.05),
+            (0.0, -40.0),
+        ] {
             let mut y = [0.0; N];
             y[ix::YB] = -3.7e-6;
             y[ix::XR] = 0.4e-6;
@@ -261,7 +266,10 @@ mod tests {
                         let kept = f.drag_powers;
                         assert_eq!(
                             (kept.nu0_n_pow_2_3.to_bits(), kept.load_torque_n_m.to_bits()),
-                            (fresh.nu0_n_pow_2_3.to_bits(), fresh.load_torque_n_m.to_bits()),
+                            (
+                                fresh.nu0_n_pow_2_3.to_bits(),
+                                fresh.load_torque_n_m.to_bits()
+                            ),
                             "{mode:?}, race spin {wb}"
                         );
                         // Not a vacuous comparison: the powers are there.
