@@ -94,19 +94,20 @@ impl Fidelity {
 
     /// The scene keys (dotted, as `--set` takes them) that [`Fidelity::apply`] sets: a value
     /// given for one of them before the preset is applied does not survive it.
-    pub const KEYS: [&'static str; 6] = [
+    pub const KEYS: [&'static str; 7] = [
         "solver.rtol",
         "solver.method",
         "solver.free_flight_gap_bound",
         "solver.race_atol_scale",
         "solver.race_velocity_atol_from_force",
+        "solver.bdf_max_order",
         "quasi_static_race",
     ];
 
     /// Sets the preset's numerics on `scene` (tolerance, integrator, gap bound, race
-    /// tolerance scale, the race's velocity tolerance from the force), and the full model
-    /// (`quasi_static_race` off): the keys of [`Fidelity::KEYS`]. The physics a user chose
-    /// stays as it is.
+    /// tolerance scale, the race's velocity tolerance from the force, the BDF's highest
+    /// order), and the full model (`quasi_static_race` off): the keys of [`Fidelity::KEYS`].
+    /// The physics a user chose stays as it is.
     pub fn apply(self, scene: &mut Scene) {
         let p = self.solver();
         let s = &mut scene.solver;
@@ -115,6 +116,7 @@ impl Fidelity {
         s.free_flight_gap_bound = p.free_flight_gap_bound;
         s.race_atol_scale = p.race_atol_scale;
         s.race_velocity_atol_from_force = p.race_velocity_atol_from_force;
+        s.bdf_max_order = p.bdf_max_order;
         scene.quasi_static_race = false;
     }
 
@@ -199,6 +201,7 @@ mod tests {
                 "solver.race_velocity_atol_from_force",
                 serde_json::json!(false),
             ),
+            ("solver.bdf_max_order", serde_json::json!(2)),
             ("quasi_static_race", serde_json::json!(true)),
         ];
         let keys: Vec<&str> = other.iter().map(|(k, _)| *k).collect();

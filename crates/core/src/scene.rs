@@ -54,7 +54,8 @@ pub enum Method {
     /// RADAU5, the 3-stage Radau IIA collocation method of order 5 (Hairer and Wanner) on
     /// the full Jacobian, with a simplified Newton iteration (`ode/radau5.rs`).
     Radau5,
-    /// BDF, the backward differentiation formulas of orders 1-5 with variable order and
+    /// BDF, the backward differentiation formulas of orders 1 to `bdf_max_order` (4 by
+    /// default, at most 5) with variable order and
     /// quasi-constant step size (Shampine and Reichelt's scheme), on the full Jacobian with
     /// Newton's iteration from the Jacobian at each step's prediction (`ode/bdf.rs`). Alone
     /// it restarts at order 1 after every mode switch.
@@ -175,6 +176,16 @@ pub struct SolverSettings {
     /// or without damping (`c1` or `c2` zero). Default true (the `standard` fidelity); false
     /// in `draft` and `reference` (docs/accuracy.md#the-races-velocity-tolerance-in-contact).
     pub race_velocity_atol_from_force: bool,
+    /// The highest order of the multistep method of `rodas4_bdf`, `rodas4_ndf` and `bdf`
+    /// (unused by the other methods). Orders 3 to 5 are not A-stable: each is unstable on a
+    /// bounded region of the left half-plane beside the imaginary axis. Rolling in the race,
+    /// the rotor and race have lightly damped modes (about 0.3, 1.9 and 15 kHz, damping
+    /// ratios 3 to 30 %) on which order 5 is unstable over almost every step size, so its
+    /// steps are short and often rejected; at order 4 the 1 s pendulum drop takes 0.72 of
+    /// the steps (docs/performance.md#the-bdfs-highest-order). Default 4 (the `standard`
+    /// fidelity's, from model version 13); 5 is model version 12's stepper. Allowed [1, 5],
+    /// a whole number.
+    pub bdf_max_order: u32,
 }
 
 // Exact comparison on purpose: only the default is left out of the JSON.
@@ -197,6 +208,7 @@ impl Default for SolverSettings {
             free_flight_gap_bound: true,
             race_atol_scale: 1.0,
             race_velocity_atol_from_force: true,
+            bdf_max_order: 4,
         }
     }
 }
@@ -805,6 +817,13 @@ impl Scene {
             (1.0..=1e4).contains(&s.race_atol_scale),
             "[1, 1e4]",
         )?;
+        if !(1..=5).contains(&s.bdf_max_order) {
+            return Err(InvalidParameter::new(
+                "solver.bdf_max_order",
+                s.bdf_max_order,
+                "[1, 5], a whole number",
+            ));
+        }
         if s.max_step_attempts == 0 {
             return Err(InvalidParameter::new("solver.max_step_attempts", 0, ">= 1"));
         }
@@ -1031,6 +1050,22 @@ mod tests {
                 serde_json::from_str::<Method>(&format!("\"{name}\"")).unwrap(),
                 m
             );
+        }
+    }
+
+    #[test]
+    fn the_bdfs_highest_order_is_checked() {
+        for (order, ok) in [(0, false), (1, true), (4, true), (5, true), (6, false)] {
+            let mut s = Scene::paper();
+            s.solver.bdf_max_order = order;
+            match s.validate() {
+                Ok(()) => assert!(ok, "{order} accepted"),
+                Err(e) => {
+                    assert!(!ok, "{order} refused: {e}");
+                    assert_eq!(e.field, "solver.bdf_max_order");
+                    assert!(e.to_string().contains(&format!("= {order}")), "{e}");
+                }
+            }
         }
     }
 

@@ -105,6 +105,7 @@ pub const FIELD_RANGES: &[FieldRange] = &[
     r("solver.max_step_attempts", Some(In(1.0)), None),
     r("solver.max_events", Some(In(1.0)), None),
     r("solver.race_atol_scale", Some(In(1.0)), Some(In(1e4))),
+    r("solver.bdf_max_order", Some(In(1.0)), Some(In(5.0))),
     r("thermal.macro_step_s", Some(In(1e-6)), Some(In(1.0))),
     r(
         "thermal.ambient_temperature_k",
@@ -397,7 +398,12 @@ mod tests {
         if !node.is_object() {
             *node = Value::Object(Default::default());
         }
-        let integer = ["ball_count", "balls_per_row", "bearing.rows"];
+        let integer = [
+            "ball_count",
+            "balls_per_row",
+            "bearing.rows",
+            "solver.bdf_max_order",
+        ];
         let value = if integer.iter().any(|i| key.ends_with(i)) || key.starts_with("solver.max_") {
             if v < 0.0 || v.fract() != 0.0 {
                 return None;

@@ -3,7 +3,10 @@
 //! the end time is not an underflow, a state that is not finite fails at once, and a restart
 //! announced as no mode switch keeps the history only where the last step ended.
 
-use whirlmap_core::ode::{integrate, Bdf, Formula, NoObserver, Rodas4Bdf, StepControl, Stepper};
+use std::ops::ControlFlow;
+use whirlmap_core::ode::{
+    integrate, Bdf, Formula, NoObserver, Observer, Rodas4Bdf, StepControl, StepView, Stepper,
+};
 use whirlmap_core::SolveError;
 
 mod common;
@@ -34,6 +37,44 @@ fn rodas4_then_bdf_hands_over_and_the_bdf_takes_most_of_a_smooth_run() {
     let steps = st.stats().steps;
     assert!(2 * st.bdf_steps() > steps, "{} of {steps}", st.bdf_steps());
     assert!(err < 100.0 * 1e-8, "error {err:e}");
+}
+
+/// The highest multistep order of the accepted steps.
+struct HighestOrder(usize);
+impl<S: whirlmap_core::ode::OdeSystem<2>> Observer<S, 2> for HighestOrder {
+    type Halt = std::convert::Infallible;
+    fn on_step(&mut self, _sys: &S, s: &StepView<'_, 2>) -> ControlFlow<Self::Halt> {
+        self.0 = self.0.max(s.dense.multistep_order().unwrap_or(0));
+        ControlFlow::Continue(())
+    }
+}
+
+#[test]
+fn rodas4_then_bdf_hands_over_at_any_highest_order() {
+    // Capped below the hand-over's order 3 the BDF is seeded at the cap. At every cap the
+    // BDF takes over and reaches the cap but no higher, and on this undamped oscillator
+    // (about three periods) a higher cap takes fewer steps at the same tolerance; the lower
+    // orders' local errors add up over many more steps (implicit Euler's also damp it).
+    let mut runs = Vec::new();
+    for cap in 1..=5 {
+        let mut st = Rodas4Bdf::new(ctl(1e-8, 1_000_000)).with_max_order(cap);
+        let (mut t, mut y) = (0.0, [1.0, 0.0]);
+        let mut highest = HighestOrder(0);
+        integrate(&HARMONIC, &mut st, &mut t, &mut y, 20.0, &mut highest).unwrap();
+        let err = (y[0] - t.cos()).abs().max((y[1] + t.sin()).abs());
+        assert_eq!(st.handovers(), 1, "cap {cap}");
+        assert_eq!(highest.0, cap, "cap {cap}");
+        runs.push((st.stats().steps, err));
+    }
+    for w in runs.windows(2) {
+        assert!(w[1].0 < w[0].0, "{runs:?}");
+    }
+    for w in runs[..4].windows(2) {
+        assert!(w[1].1 < w[0].1, "{runs:?}");
+    }
+    for (steps, err) in &runs[3..] {
+        assert!(*err < 100.0 * 1e-8, "{steps} steps, error {err:e}");
+    }
 }
 
 #[test]

@@ -46,6 +46,16 @@
 //! stability angle (80 degrees against 86, 66 against 73); order 5 is the BDF. The plain BDF
 //! ([`Formula::Bdf`]) is the default.
 //!
+//! **The highest order.** [`Bdf::with_max_order`] caps the order selection (5 by default
+//! here; the drop takes `solver.bdf_max_order`, 4 by default). Orders 3 to 5 are not
+//! A-stable: each is unstable on a bounded region of the left half-plane beside the imaginary
+//! axis, so a lightly damped mode whose `h lambda` falls there grows. Rolling in the race,
+//! the drop model's Jacobian has such modes at about 0.3, 1.9 and 15 kHz (damping ratios
+//! 0.03, 0.30 and 0.20): order 5 is unstable on the 1.9 kHz mode from `h |lambda| = 1.05` and
+//! on the 15 kHz mode up to `h |lambda| = 7.66`, which leaves it a window of some 4 us of
+//! step sizes, while order 4 is stable on the 1.9 kHz mode at any step, on the 15 kHz mode
+//! above `h |lambda| = 3.2` and on the 0.3 kHz mode below 0.65: from 35 to 340 us.
+//!
 //! What it costs: after every restart it starts again at order 1 from a short step, so a
 //! drop with many mode switches takes many low-order steps (see [`super::Rodas4Bdf`], which
 //! leaves those to RODAS4), and a BDF of order 3 or more is not A-stable. Its interpolant is
@@ -236,6 +246,8 @@ pub struct Bdf<const N: usize> {
     proposal: f64,
     /// `kappa_k` of the formulas ([`Formula`]); zero for the BDF.
     kappa: [f64; MAX_ORDER + 1],
+    /// The highest order the order selection may raise to ([`Bdf::with_max_order`]).
+    max_order: usize,
 }
 
 /// One attempt's outcome.
@@ -269,7 +281,26 @@ impl<const N: usize> Bdf<N> {
             last_capped: false,
             proposal: 0.0,
             kappa: formula.kappa(),
+            max_order: MAX_ORDER,
         }
+    }
+
+    /// The same stepper with its order capped at `max_order` (clamped to `1..=5`; 5 by
+    /// default), for use when the stepper is built (the differences are not touched).
+    /// Orders 3 to 5 are not A-stable: each is unstable on a bounded region of the left
+    /// half-plane beside the imaginary axis (the BDF's stability angles are 86, 73 and 52
+    /// degrees, the NDF's 80, 66 and 52), so a lightly damped mode that a step spans can
+    /// grow under them. On the drop model such modes leave order 5 almost no stable step
+    /// (`solver.bdf_max_order`, docs/performance.md#the-bdfs-highest-order).
+    pub fn with_max_order(mut self, max_order: usize) -> Self {
+        self.max_order = max_order.clamp(1, MAX_ORDER);
+        self.order = self.order.min(self.max_order);
+        self
+    }
+
+    /// The highest order the stepper may take.
+    pub fn max_order(&self) -> usize {
+        self.max_order
     }
 
     /// The error constant of order `k` in units of `nabla^{k+1} y`:
@@ -319,7 +350,11 @@ impl<const N: usize> Bdf<N> {
     /// after a one-step method's, [`super::Rodas4Bdf`]).
     pub(super) fn seed(&mut self, values: &[[f64; N]], h: f64) {
         let order = values.len() - 1;
-        debug_assert!((1..=MAX_ORDER).contains(&order));
+        assert!(
+            (1..=self.max_order).contains(&order),
+            "seeded at order {order}, the highest is {}",
+            self.max_order
+        );
         // The difference table: after pass m, v[j] = nabla^m y(t - (j - m) h) for j >= m.
         let mut v = [[0.0; N]; MAX_ORDER + 1];
         v[..=order].copy_from_slice(values);
@@ -601,7 +636,7 @@ impl<const N: usize> Stepper<N> for Bdf<N> {
             } else {
                 f64::INFINITY
             };
-            let e_plus = if order < MAX_ORDER {
+            let e_plus = if order < self.max_order {
                 scaled_norm(
                     self.error_constant(order + 1),
                     &self.d[order + 2],
@@ -861,6 +896,109 @@ mod tests {
             (t, y) = (d.t1(), d.y1());
         }
         y[0] - (-t).exp()
+    }
+
+    /// A damped oscillator `x'' + 2 zeta x' + x = 0` as `(x, v)`, with its Jacobian, whose
+    /// eigenvalues `-zeta +- i sqrt(1 - zeta^2)` lie at `acos(zeta)` from the negative real
+    /// axis.
+    struct Oscillator {
+        zeta: f64,
+    }
+    impl Oscillator {
+        /// The solution from `(1, -zeta)` at `t = 0`: `x = e^(-zeta t) cos(w t)`.
+        fn exact(&self, t: f64) -> [f64; 2] {
+            let w = (1.0 - self.zeta * self.zeta).sqrt();
+            let e = (-self.zeta * t).exp();
+            let (s, c) = (w * t).sin_cos();
+            [e * c, -e * (self.zeta * c + w * s)]
+        }
+    }
+    impl OdeSystem<2> for Oscillator {
+        type Guard = crate::ode::NoGuard;
+        fn rhs(&self, _t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+            dy[0] = y[1];
+            dy[1] = -y[0] - 2.0 * self.zeta * y[1];
+        }
+        fn stiff_jacobian(&self, _t: f64, _y: &[f64; 2]) -> Option<crate::ode::StiffJacobian> {
+            let mut s = crate::ode::StiffJacobian::over(&[0, 1]);
+            s.jac[(0, 1)] = 1.0;
+            s.jac[(1, 0)] = -1.0;
+            s.jac[(1, 1)] = -2.0 * self.zeta;
+            Some(s)
+        }
+    }
+
+    #[test]
+    fn order_5_lets_a_damped_mode_spanned_by_its_steps_grow_and_order_4_damps_it() {
+        // A mode of damping ratio 0.2957 (72.8 degrees from the negative real axis, like the
+        // drop model's 1.9 kHz mode while rolling) at h |lambda| = 3: inside order 5's
+        // unstable wedge (stability angle 51.8 degrees; its largest root there is 1.16 in
+        // modulus), outside order 4's (73.4 degrees; root 0.96). The exact solution falls
+        // by e^-177 over the 200 steps.
+        let osc = Oscillator { zeta: 0.2957 };
+        let h = 3.0;
+        let run = |order: usize| {
+            let ctl = StepControl {
+                rtol: 1e-6,
+                atol: [1e-9; 2],
+                h_min: 0.0,
+                max_attempts: u64::MAX,
+                fixed_step: Some(h),
+            };
+            let mut st = Bdf::<2>::new(ctl);
+            let v: Vec<[f64; 2]> = (0..=order).map(|j| osc.exact(-(j as f64) * h)).collect();
+            st.seed(&v, h);
+            let (mut t, mut y) = (0.0, osc.exact(0.0));
+            for _ in 0..200 {
+                let d = st.step(&osc, t, &y, f64::INFINITY).unwrap();
+                (t, y) = (d.t1(), d.y1());
+            }
+            assert_eq!(st.order(), order);
+            y[0].hypot(y[1])
+        };
+        let (at4, at5) = (run(4), run(5));
+        assert!(at5 > 1e6, "order 5: {at5:e}");
+        assert!(at4 < 1e-2, "order 4: {at4:e}");
+    }
+
+    #[test]
+    fn the_order_selection_stays_at_or_below_the_cap() {
+        // A smooth problem at a tight tolerance, on which the order selection reaches 5
+        // uncapped: capped at 4 (and 2) it never goes above the cap, and it still converges.
+        let osc = Oscillator { zeta: 0.05 };
+        let run = |cap: Option<usize>| {
+            let ctl = StepControl {
+                rtol: 1e-10,
+                atol: [1e-12; 2],
+                h_min: 1e-12,
+                max_attempts: 1_000_000,
+                fixed_step: None,
+            };
+            let mut st = Bdf::<2>::new(ctl);
+            if let Some(k) = cap {
+                st = st.with_max_order(k);
+            }
+            let (mut t, mut y) = (0.0, osc.exact(0.0));
+            st.restart(&osc, t, &y);
+            let mut highest = 0;
+            while t < 20.0 {
+                let d = st.step(&osc, t, &y, 20.0 - t).unwrap();
+                (t, y) = (d.t1(), d.y1());
+                highest = highest.max(st.order());
+            }
+            let e = osc.exact(t);
+            (highest, (y[0] - e[0]).hypot(y[1] - e[1]))
+        };
+        let (free, free_err) = run(None);
+        assert_eq!(free, 5);
+        for cap in [4, 2] {
+            let (highest, err) = run(Some(cap));
+            assert_eq!(highest, cap);
+            assert!(
+                err < 1e-6 && free_err < 1e-6,
+                "cap {cap}: {err:e}, uncapped {free_err:e}"
+            );
+        }
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //! RODAS4 has taken [`HANDOVER_STEPS`] steps and [`HANDOVER_S`] of time since the restart,
 //! and the system sets no step bound (in a drop: the contact carries, so no free-flight
 //! bound), the BDF ([`super::Bdf`]) takes over until the next restart. It starts at order
-//! [`SEED_ORDER`] and RODAS4's step size from RODAS4's last steps, read at equal spacing from
+//! [`SEED_ORDER`] (or its highest order, if lower) and RODAS4's step size from RODAS4's last steps, read at equal spacing from
 //! their cubic Hermite interpolants (RODAS4's own dense output).
 //!
 //! Why: rolling or whirling in the race, a BDF step costs one or two model evaluations, one
@@ -106,6 +106,13 @@ impl<const N: usize> Rodas4Bdf<N> {
         }
     }
 
+    /// The same stepper with the BDF's (or NDF's) order capped at `max_order`
+    /// ([`Bdf::with_max_order`]); it then takes over at order 3 or `max_order`, the lower.
+    pub fn with_max_order(mut self, max_order: usize) -> Self {
+        self.bdf = self.bdf.with_max_order(max_order);
+        self
+    }
+
     /// Hand-overs to the BDF (or NDF) so far.
     pub fn handovers(&self) -> u64 {
         self.handovers
@@ -166,14 +173,16 @@ impl<const N: usize> Rodas4Bdf<N> {
         }
         // SEED_ORDER + 1 values at RODAS4's next step size, or closer where the kept steps
         // span less.
+        // (At most the BDF's highest order.)
+        let order = SEED_ORDER.min(self.bdf.max_order());
         let span = t - self.history[0].0;
-        let h = self.rodas.core().h.min(span / SEED_ORDER as f64);
+        let h = self.rodas.core().h.min(span / order as f64);
         let mut values = [[0.0; N]; SEED_ORDER + 1];
         values[0] = y;
-        for (j, v) in values.iter_mut().enumerate().skip(1) {
+        for (j, v) in values.iter_mut().enumerate().take(order + 1).skip(1) {
             *v = self.hermite_at(t - j as f64 * h);
         }
-        self.bdf.seed(&values, h);
+        self.bdf.seed(&values[..=order], h);
         self.phase = Phase::Bdf;
         self.handovers += 1;
     }
