@@ -94,7 +94,7 @@ fn a_preset_says_which_set_values_it_replaces() {
     let out = whirlmap(&base);
     assert!(
         String::from_utf8_lossy(&out.stdout).contains(
-            "numerics              rodas4, rtol 1e-4, race tolerance x1000 (the draft preset)"
+            "numerics              rodas4_bdf, rtol 1e-4, race tolerance x1000 (the draft preset)"
         ),
         "{}",
         String::from_utf8_lossy(&out.stdout)
@@ -147,7 +147,7 @@ fn a_sweep_file_says_which_scene_values_its_preset_replaces() {
         let manifest = read_json(&out_dir.join("manifest.json"));
         let preset = &manifest["preset_solver"];
         assert_eq!(preset["rtol"], 1e-4, "{manifest}");
-        assert_eq!(preset["method"], "rodas4", "{manifest}");
+        assert_eq!(preset["method"], "rodas4_bdf", "{manifest}");
         assert_eq!(preset["race_atol_scale"], 1000.0, "{manifest}");
         assert_eq!(
             preset["max_step_attempts"], 100000,

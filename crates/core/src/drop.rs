@@ -22,7 +22,9 @@ use std::ops::ControlFlow;
 /// - 13: the BDF (and the NDF) of `rodas4_bdf`, `rodas4_ndf` and `bdf` go up to order 4,
 ///   not 5 (`solver.bdf_max_order`): order 5 is unstable on the lightly damped modes of the
 ///   rotor and race rolling in the race over most of its step sizes, so the 1 s pendulum
-///   drop took 1.4 times the steps and twice the rejections it takes at order 4.
+///   drop took 1.4 times the steps and twice the rejections it takes at order 4. With it
+///   the `draft` preset became RODAS4 then BDF as well (a preset sets the scene's numerics,
+///   so that moves no result of a given scene; docs/accuracy.md#why-draft-is-rodas4-then-bdf).
 /// - 12: the `standard` numerics step with RODAS4 after every mode switch and with the BDF,
 ///   at a tenth of the tolerance, once the contact has been carried for 2 ms and 12 steps
 ///   (`solver.method = "rodas4_bdf"`, [`crate::ode::Rodas4Bdf`]): as close to `reference`
@@ -56,7 +58,7 @@ use std::ops::ControlFlow;
 /// - 5: the `standard` numerics are DOPRI5 at rtol 3e-5: ROS34PW2 with the race tolerance
 ///   x1000 missed the accuracy budget by up to 12 % in the maximum force of bouncing
 ///   sequences and became the `draft` preset (until RODAS4 with the same tolerances
-///   replaced it, docs/accuracy.md#why-draft-is-rodas4).
+///   replaced it, docs/accuracy.md#why-draft-is-rodas4-then-bdf).
 /// - 4: the `standard` numerics (ROS34PW2, gap bound, race tolerance x1000, rtol 1e-4) are
 ///   the scene's default solver settings, every solver setting is in the scene's JSON, and
 ///   whirl turn times are interpolated between the angle's samples.

@@ -16,15 +16,16 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
-    /// Screening: RODAS4 with the free-flight gap bound and the race's absolute tolerances
-    /// x1000, at rtol 1e-4: the most accurate setting at its cost in the `draft` study
-    /// (`results/accuracy-draft/`). About 0.7 of `standard`'s time, but outside the
-    /// accuracy budget: on bouncing sequences its maximum force is off by up to 0.23 %
-    /// (docs/accuracy.md#fidelity-presets).
+    /// Screening: RODAS4 then BDF (as `standard`'s stepper) with the free-flight gap bound
+    /// and the race's absolute tolerances x1000, at rtol 1e-4: the most accurate setting at
+    /// its cost in the `draft` study (`results/accuracy-draft/`; RODAS4 alone with the same
+    /// numerics until 2026-11-29, whose forces it keeps for 0.58 of its RHS evaluations).
+    /// About 0.8 of `standard`'s time, but outside the accuracy budget: on bouncing
+    /// sequences its maximum force is off by up to 0.23 % (docs/accuracy.md#fidelity-presets).
     Draft,
     /// Design work, and the scene default: RODAS4 then BDF (RODAS4 after every mode switch,
-    /// the BDF at a tenth of the tolerance once the contact has run smoothly for 2 ms; model
-    /// version 12) on the full Jacobian at rtol 3e-5, with the free-flight gap bound and the
+    /// the BDF of orders up to 4 at a tenth of the tolerance once the contact has run
+    /// smoothly for 2 ms; model versions 12 and 13) on the full Jacobian at rtol 3e-5, with the free-flight gap bound and the
     /// race's velocity tolerance widened from the contact force in contact (every other
     /// tolerance the rotor's); within the budget with its tolerance
     /// neighbours within it too, with a margin of two on the worst case (first and maximum
@@ -74,7 +75,7 @@ impl Fidelity {
         match self {
             Fidelity::Draft => SolverSettings {
                 rtol: 1e-4,
-                method: Method::Rodas4,
+                method: Method::Rodas4Bdf,
                 free_flight_gap_bound: true,
                 race_atol_scale: 1000.0,
                 race_velocity_atol_from_force: false,

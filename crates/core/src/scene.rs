@@ -42,11 +42,11 @@ pub enum Method {
     /// 2005) with an analytic stiff Jacobian: its step is not bounded by the light race's
     /// contact mode (`ode/rosw.rs`). Was the `draft` fidelity's, until RODAS4 at the same
     /// tolerances measured fifty times closer to `reference` for 1.19 times the RHS
-    /// evaluations and about the same time (docs/accuracy.md#why-draft-is-rodas4).
+    /// evaluations and about the same time (docs/accuracy.md#why-draft-is-rodas4-then-bdf).
     Ros34pw2,
     /// RODAS4, a Rosenbrock method of order 4 (Hairer and Wanner) on the full Jacobian and
-    /// the factors of ROS34PW2 (`ode/rodas.rs`): the `draft` fidelity's at rtol 1e-4, and the
-    /// `standard` fidelity's (the scene default) until model version 11.
+    /// the factors of ROS34PW2 (`ode/rodas.rs`): the `draft` fidelity's at rtol 1e-4 until
+    /// 2026-11-29, and the `standard` fidelity's (the scene default) until model version 11.
     Rodas4,
     /// Rodas5P, a Rosenbrock method of order 5 (Steinebach 2023) on the full Jacobian and
     /// the factors of RODAS4 (`ode/rodas5p.rs`).
@@ -134,11 +134,12 @@ pub struct SolverSettings {
     pub max_step_attempts: u64,
     /// Located mode switches before a typed budget error (chatter guard). Default 2 000 000.
     pub max_events: u64,
-    /// The integrator. Default `rodas4_bdf` (the `standard` fidelity's): RODAS4 after each
-    /// mode switch, which takes the impacts, and the variable-order BDF once the contact has
-    /// run smoothly for 2 ms (docs/model.md#integrator); `rodas4`, the 4th-order Rosenbrock
-    /// method on the model's full Jacobian, whose step is not bounded by the light race's
-    /// contact modes (the `draft` fidelity's, and the default until model version 11);
+    /// The integrator. Default `rodas4_bdf` (the `standard` and `draft` fidelities'): RODAS4
+    /// after each mode switch, which takes the impacts, and the variable-order BDF once the
+    /// contact has run smoothly for 2 ms (docs/model.md#integrator); `rodas4`, the 4th-order
+    /// Rosenbrock method on the model's full Jacobian, whose step is not bounded by the light
+    /// race's contact modes (the `draft` fidelity's until 2026-11-29, and the default until
+    /// model version 11);
     /// `bdf`, the BDF alone; `rodas4_ndf`, RODAS4 then the NDF (ode15s's formulas) in place
     /// of the BDF (docs/performance.md#the-ndf-measured); `dopri5`, the explicit
     /// Dormand-Prince 5(4) pair (the `reference` fidelity's);

@@ -1178,7 +1178,7 @@ mod tests {
         assert!(replaced_by_fidelity(&v).is_empty());
         v["fidelity"] = "draft".into();
         // The preset's own values are not replaced: draft's method and race tolerance scale.
-        v["scene"]["solver"]["method"] = "rodas4".into();
+        v["scene"]["solver"]["method"] = "rodas4_bdf".into();
         v["scene"]["solver"]["race_atol_scale"] = 1e3.into();
         v["scene"]["quasi_static_race"] = true.into();
         v["scene"]["solver"]["max_step_attempts"] = 40.into();
