@@ -1003,6 +1003,8 @@ fn a_draft_search_rechecked_at_standard_finds_the_main_job_s_onsets() {
     }
     // mu 0.05-0.2 and 0.3 (no whirl); mu 0.35, 0.4 and 0.5 (brackets).
     assert_eq!((confirmed_no_whirl, confirmed_brackets), (5, 3), "{rows:?}");
+    let r = rows.iter().find(|r| r["mu"] == 0.5).unwrap();
+    assert_eq!(r["recheck"]["confirmed"], true, "{r}");
     // mu 0.25, where `draft` is 62.5 r/min low: not confirmed, and found in the window.
     let r = rows.iter().find(|r| r["mu"] == 0.25).unwrap();
     assert_eq!(r["recheck"]["confirmed"], false, "{r}");

@@ -22,9 +22,11 @@ use std::ops::ControlFlow;
 /// - 13: the BDF (and the NDF) of `rodas4_bdf`, `rodas4_ndf` and `bdf` go up to order 4,
 ///   not 5 (`solver.bdf_max_order`): order 5 is unstable on the lightly damped modes of the
 ///   rotor and race rolling in the race over most of its step sizes, so the 1 s pendulum
-///   drop took 1.4 times the steps and twice the rejections it takes at order 4. With it
-///   the `draft` preset became RODAS4 then BDF as well (a preset sets the scene's numerics,
-///   so that moves no result of a given scene; docs/accuracy.md#why-draft-is-rodas4-then-bdf).
+///   drop took 1.4 times the steps and twice the rejections it takes at order 4. Later in
+///   version 13 the `draft` preset became RODAS4 then BDF as well: a preset sets the scene's
+///   numerics, so that moves no result of a given scene; a record's scene hash, and a
+///   sweep manifest's `preset_solver`, tell the two `draft`s apart
+///   (docs/accuracy.md#why-draft-is-rodas4-then-bdf).
 /// - 12: the `standard` numerics step with RODAS4 after every mode switch and with the BDF,
 ///   at a tenth of the tolerance, once the contact has been carried for 2 ms and 12 steps
 ///   (`solver.method = "rodas4_bdf"`, [`crate::ode::Rodas4Bdf`]): as close to `reference`
@@ -236,7 +238,8 @@ fn check_friction_heat(energy: &EnergyAudit, drop_energy_j: f64, t: f64) -> Resu
 /// absolute tolerance loosened 1e4-fold under the explicit DOPRI5 stepper at no spin),
 /// measured 1.0 to 1.7, as did a rotor inertia of 1e-300 kg m^2 that validation now
 /// refuses. 0.5 lies between the two. An undamped drop without spin over a full second closes
-/// to 3.6e-3 at the `draft` preset; the former `draft` (ROS34PW2 with the race's tolerances
+/// to 3.6e-3 at the `draft` preset (as RODAS4, and as RODAS4 then BDF since 2026-11-29);
+/// the former `draft` (ROS34PW2 with the race's tolerances
 /// widened) crossed the threshold there, damping the undamped contact oscillations
 /// numerically and losing 0.88-0.91 of the fall's energy, so that drop failed, rightly, since
 /// its numbers were not to be trusted (docs/accuracy.md#energy-audit).

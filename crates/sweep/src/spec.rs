@@ -1177,14 +1177,16 @@ mod tests {
         v["fidelity"] = "fast".into();
         assert!(replaced_by_fidelity(&v).is_empty());
         v["fidelity"] = "draft".into();
-        // The preset's own values are not replaced: draft's method and race tolerance scale.
-        v["scene"]["solver"]["method"] = "rodas4_bdf".into();
+        // The preset's own values are not replaced: draft's race tolerance scale (its method,
+        // RODAS4 then BDF, replaces the file's RODAS4).
+        v["scene"]["solver"]["method"] = "rodas4".into();
         v["scene"]["solver"]["race_atol_scale"] = 1e3.into();
         v["scene"]["quasi_static_race"] = true.into();
         v["scene"]["solver"]["max_step_attempts"] = 40.into();
         let listed = replaced_by_fidelity(&v);
         let want = [
             ("scene.solver.rtol", "1e-6"),
+            ("scene.solver.method", "\"rodas4\""),
             ("scene.quasi_static_race", "true"),
         ];
         let want: Vec<(String, String)> = want
