@@ -7,8 +7,9 @@
 //! RODAS4 has taken [`HANDOVER_STEPS`] steps and [`HANDOVER_S`] of time since the restart,
 //! and the system sets no step bound (in a drop: the contact carries, so no free-flight
 //! bound), the BDF ([`super::Bdf`]) takes over until the next restart. It starts at order
-//! [`SEED_ORDER`] (or its highest order, if lower) and RODAS4's step size from RODAS4's last steps, read at equal spacing from
-//! their cubic Hermite interpolants (RODAS4's own dense output).
+//! [`SEED_ORDER`] (or its highest order, if lower) and RODAS4's step size from RODAS4's last
+//! steps, read at equal spacing from their cubic Hermite interpolants (RODAS4's own dense
+//! output).
 //!
 //! Why: rolling or whirling in the race, a BDF step costs one or two model evaluations, one
 //! Jacobian, one factorisation and one or two solves, against RODAS4's six, one, one and six;
