@@ -26,6 +26,10 @@
 //! the stepper's own tolerance; each failure then paid a new Jacobian and the iterations
 //! lost). So each attempt takes the Jacobian at its prediction `y_pred` (the model
 //! evaluation there serves the iteration's first right-hand side too) and factors `I - c J`.
+//! Re-measured at order 4 (model version 13), a Jacobian kept until the iteration fails took
+//! the pendulum drop's RHS evaluations from 18 029 to 27 878: the kept one's iteration does
+//! not contract in the rolling
+//! (docs/performance.md#two-remedies-and-an-unrolled-factorisation-that-did-not-work).
 //!
 //! **One iteration where one is enough.** With the exact Jacobian at the starting point,
 //! Newton's iteration converges quadratically: the correction after the first one is about

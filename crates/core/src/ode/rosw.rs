@@ -47,14 +47,16 @@ const BHAT: [f64; 4] = [
     2.179_332_607_542_295_0e-1,
 ];
 
-/// `W = I - h gamma J` on the stiff components, LU-factored with partial pivoting. With `k` kinematic components ([`StiffJacobian::kinematic`]: rows `q' = v`),
-/// `W`'s first `k` rows read `q - hg v = r_q`, so `q = r_q + hg v` and only the Schur
-/// complement `S = I - hg J_vv - hg^2 J_vq` over the other components is factored:
+/// `W = I - h gamma J` on the stiff components, LU-factored with partial pivoting. With `k`
+/// kinematic components ([`StiffJacobian::kinematic`]: rows `q' = v`), `W`'s first `k` rows
+/// read `q - hg v = r_q`, so `q = r_q + hg v` and only the Schur complement
+/// `S = I - hg J_vv - hg^2 J_vq` over the other components is factored:
 /// `S v = r_v + hg J_vq r_q` (10 components with 4 positions: a 6x6 factor, 4x fewer
 /// operations than the 10x10 one). The model's 6x6 complement is factored in place in
 /// nalgebra's fixed-size storage by a hand-written kernel ([`lu6`]): nalgebra's generic LU
-/// costs 3 % more instructions on the 1 s drop at the ROS34PW2 setting of the time (94.4 M against
-/// 91.7 M, callgrind).
+/// costs 3 % more instructions on the 1 s drop at the ROS34PW2 setting of the time (94.4 M
+/// against 91.7 M, callgrind). Unrolled column by column it takes fewer instructions but more
+/// time (docs/performance.md#two-remedies-and-an-unrolled-factorisation-that-did-not-work).
 /// Other shapes (the stepper's tests) use nalgebra's LU in dynamic storage.
 #[derive(Debug, Clone)]
 pub(super) struct Lu {
