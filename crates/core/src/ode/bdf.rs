@@ -58,7 +58,10 @@
 //! 0.03, 0.30 and 0.20): order 5 is unstable on the 1.9 kHz mode from `h |lambda| = 1.05` and
 //! on the 15 kHz mode up to `h |lambda| = 7.66`, which leaves it a window of some 4 us of
 //! step sizes, while order 4 is stable on the 1.9 kHz mode at any step, on the 15 kHz mode
-//! above `h |lambda| = 3.2` and on the 0.3 kHz mode below 0.65: from 35 to 340 us.
+//! above `h |lambda| = 3.2` and on the 0.3 kHz mode below 0.65: from 35 to 340 us. (Those
+//! figures are at 0.51 s; the modes move with the rocking, and where the 1.9 kHz mode passes
+//! order 4's stability angle of 73.35 degrees, order 4 too is unstable on it for steps of
+//! about 130 to 172 us.)
 //!
 //! What it costs: after every restart it starts again at order 1 from a short step, so a
 //! drop with many mode switches takes many low-order steps (see [`super::Rodas4Bdf`], which

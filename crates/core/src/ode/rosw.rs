@@ -55,8 +55,9 @@ const BHAT: [f64; 4] = [
 /// operations than the 10x10 one). The model's 6x6 complement is factored in place in
 /// nalgebra's fixed-size storage by a hand-written kernel ([`lu6`]): nalgebra's generic LU
 /// costs 3 % more instructions on the 1 s drop at the ROS34PW2 setting of the time (94.4 M
-/// against 91.7 M, callgrind). Unrolled column by column it takes fewer instructions but more
-/// time (docs/performance.md#two-remedies-and-an-unrolled-factorisation-that-did-not-work).
+/// against 91.7 M, callgrind). Unrolled column by column it took 4 % fewer of the drop's
+/// instructions but more time
+/// (docs/performance.md#two-remedies-and-an-unrolled-factorisation-that-did-not-work).
 /// Other shapes (the stepper's tests) use nalgebra's LU in dynamic storage.
 #[derive(Debug, Clone)]
 pub(super) struct Lu {
