@@ -970,8 +970,7 @@ mod tests {
                 rtol: 1e-10,
                 atol: [1e-12; 2],
                 h_min: 1e-12,
-                max_attempts: 1_000_000,
-                fixed_step: None,
+                ..ctl(None)
             };
             let mut st = Bdf::<2>::new(ctl);
             if let Some(k) = cap {
