@@ -56,7 +56,9 @@ const PEER_MS: f64 = 58.0;
 /// damper took 1.28 times the peer's wall time. On a busy machine the absolute times drift,
 /// so the bench also states each row against that DOPRI5 row, run here in the same process,
 /// times 1.28: an estimate of the ratio to the peer that does not depend on the machine's
-/// load.
+/// load. Re-checked on 2026-11-29 against the build of the side-by-side measurement, run
+/// alternately on one machine: today's DOPRI5 row takes 0.975-0.99 of its time
+/// (docs/performance.md#the-yardstick-re-checked-and-where-the-touchdowns-work-goes).
 const DOPRI5_OVER_PEER: f64 = 1.28;
 /// See [`PEER_MS`].
 const PEER_RHS: f64 = 456_000.0;

@@ -1,13 +1,18 @@
 //! Ad-hoc diagnostic: accepted steps of a 1 s drop per 50 ms window and per mode (free,
 //! sticking, slipping), to see where a stepper spends its steps.
 //! `cargo run --release -p whirlmap-core --example steps -- [rtol=1e-4] [ros=true]
-//! [hyb=true] [ndf=true] [bdf=true] [gap=true] [radial=true] [race=1000] [mu=0.1] [rpm=8000]`.
+//! [hyb=true] [ndf=true] [bdf=true] [gap=true] [radial=true] [race=1000] [mu=0.1] [rpm=8000]
+//! [segs=0.1]`. With `segs=T` it also lists the stretches of one mode (contact, the race on
+//! its balls, slip) that start before `T` seconds, with their steps and computed force-model
+//! evaluations: the touchdown's impacts, hops and race bounces one by one.
 use std::convert::Infallible;
 use std::ops::ControlFlow;
 use whirlmap_core::ode::{Observer, StepView};
 use whirlmap_core::*;
 struct Rec(
-    Vec<(f64, f64, bool, i32, u64)>,
+    /// Per accepted step: start, end, contact, slip (0 sticking, else its sign), computed
+    /// model evaluations so far, the race on its balls.
+    Vec<(f64, f64, bool, i32, u64, bool)>,
     model::ModelEvals,
     Vec<(f64, f64, f64)>,
     /// Accepted multistep steps per order (index 0: one-step methods' steps).
@@ -31,6 +36,7 @@ impl Observer<model::DropSystem, { model::N }> for Rec {
             m.contact,
             sl,
             sys.model_evals().computed,
+            m.support,
         ));
         if !m.contact {
             use whirlmap_core::ode::OdeSystem;
@@ -45,6 +51,7 @@ impl Observer<model::DropSystem, { model::N }> for Rec {
 }
 fn main() {
     let mut s = Scene::paper();
+    let mut segs_until_s = 0.0;
     for a in std::env::args().skip(1) {
         let (k, v) = a.split_once('=').unwrap();
         match k {
@@ -78,6 +85,7 @@ fn main() {
             "race" => s.solver.race_atol_scale = v.parse().unwrap(),
             "mu" => s.mu_dynamic = v.parse().unwrap(),
             "rpm" => s.speed_rpm = v.parse().unwrap(),
+            "segs" => segs_until_s = v.parse().unwrap(),
             _ => panic!("{k}"),
         }
     }
@@ -100,7 +108,7 @@ fn main() {
     );
     let mut w = [[0usize; 5]; 20];
     let mut prev = 0u64;
-    for &(t0, _t1, c, sl, ev) in &rec.0 {
+    for &(t0, _t1, c, sl, ev, _) in &rec.0 {
         let b = ((t0 / 0.05) as usize).min(19);
         let k = if !c {
             0
@@ -113,6 +121,32 @@ fn main() {
         w[b][3] += 1;
         w[b][4] += (ev - prev) as usize;
         prev = ev;
+    }
+    if segs_until_s > 0.0 {
+        println!("start (ms)  length (ms)  contact  on balls  slip  steps  evals");
+        let (mut i, mut before) = (0, 0u64);
+        while i < rec.0.len() && rec.0[i].0 < segs_until_s {
+            let (t0, _, c, sl, _, sup) = rec.0[i];
+            let mut j = i;
+            while j + 1 < rec.0.len()
+                && (rec.0[j + 1].2, rec.0[j + 1].3, rec.0[j + 1].5) == (c, sl, sup)
+            {
+                j += 1;
+            }
+            let (t1, ev) = (rec.0[j].1, rec.0[j].4);
+            println!(
+                "{:>10.3} {:>12.3} {:>8} {:>9} {:>5} {:>6} {:>6}",
+                t0 * 1e3,
+                (t1 - t0) * 1e3,
+                c,
+                sup,
+                sl,
+                j - i + 1,
+                ev - before
+            );
+            before = ev;
+            i = j + 1;
+        }
     }
     let capped = rec.2.iter().filter(|r| r.1 >= 0.999 * r.2).count();
     let hmean = rec.2.iter().map(|r| r.1).sum::<f64>() / rec.2.len().max(1) as f64;
