@@ -4,14 +4,18 @@
 //! [hyb=true] [ndf=true] [bdf=true] [gap=true] [radial=true] [race=1000] [mu=0.1] [rpm=8000]
 //! [segs=0.1]`. With `segs=T` it also lists the stretches of one mode (contact, the race on
 //! its balls, slip) that start before `T` seconds, with their steps and computed force-model
-//! evaluations: the touchdown's impacts, hops and race bounces one by one.
+//! evaluations: the touchdown's impacts, hops and race bounces one by one. The drop's own
+//! feature monitor runs after this observer, so the evaluations of a step's monitor samples
+//! and peak searches are counted with the next step (at a stretch's start, in the stretch
+//! before).
 use std::convert::Infallible;
 use std::ops::ControlFlow;
 use whirlmap_core::ode::{Observer, StepView};
 use whirlmap_core::*;
 struct Rec(
     /// Per accepted step: start, end, contact, slip (0 sticking, else its sign), computed
-    /// model evaluations so far, the race on its balls.
+    /// model evaluations so far (up to the step's monitor, which runs after this observer),
+    /// the race on its balls.
     Vec<(f64, f64, bool, i32, u64, bool)>,
     model::ModelEvals,
     Vec<(f64, f64, f64)>,

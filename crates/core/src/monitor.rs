@@ -498,6 +498,8 @@ impl Monitor {
 
     fn track_peaks(&mut self, sys: &DropSystem, dense: &Dense<N>, ts: [f64; 3], s: [&Sample; 3]) {
         type Get = fn(&Sample) -> f64;
+        // This step's interpolant only. (Probes lie strictly inside their step, so no time
+        // of an earlier step could match; the clear keeps the list to one step's probes.)
         self.probes.taken.clear();
         let trackers: [(Get, usize); 3] = [
             (|x| x.normal, 0),
