@@ -13,7 +13,7 @@ use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use whirlmap_core::scene::{Method, SolverSettings};
+use whirlmap_core::scene::SolverSettings;
 use whirlmap_core::{simulate, DropOptions, DropReport, Scene};
 use whirlmap_plot::render::{draw_orbit, ImageFormat};
 use whirlmap_plot::thermal::draw_temperatures;
@@ -483,11 +483,7 @@ fn numerics_line(scene: &Scene) -> String {
     if s.race_velocity_atol_from_force {
         parts.push("race velocity tolerance from the contact force".to_string());
     }
-    let multistep = matches!(
-        s.method,
-        Method::Bdf | Method::Rodas4Bdf | Method::Rodas4Ndf
-    );
-    if multistep && s.bdf_max_order != SolverSettings::default().bdf_max_order {
+    if s.method.is_multistep() && s.bdf_max_order != SolverSettings::default().bdf_max_order {
         parts.push(format!("multistep orders 1 to {}", s.bdf_max_order));
     }
     if scene.quasi_static_race {

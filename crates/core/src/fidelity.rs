@@ -23,14 +23,14 @@ pub enum Fidelity {
     /// About 0.8 of `standard`'s time, but outside the accuracy budget: on bouncing
     /// sequences its maximum force is off by up to 0.23 % (docs/accuracy.md#fidelity-presets).
     Draft,
-    /// Design work, and the scene default: RODAS4 then BDF (RODAS4 after every mode switch,
-    /// the BDF of orders up to 4 at a tenth of the tolerance once the contact has run
-    /// smoothly for 2 ms; model versions 12 and 13) on the full Jacobian at rtol 3e-5, with the free-flight gap bound and the
-    /// race's velocity tolerance widened from the contact force in contact (every other
-    /// tolerance the rotor's); within the budget with its tolerance
-    /// neighbours within it too, with a margin of two on the worst case (first and maximum
-    /// contact force and peak heat power within 0.1 % of `reference`, whirl frequency within
-    /// 1 %, the same class away from a transition; docs/accuracy.md#fidelity-presets).
+    /// Design work, and the scene default: RODAS4 then BDF (RODAS4 after every mode switch, the
+    /// BDF of orders up to 4 at a tenth of the tolerance once the contact has run smoothly for
+    /// 2 ms; model versions 12 and 13) on the full Jacobian at rtol 3e-5, with the free-flight
+    /// gap bound and the race's velocity tolerance widened from the contact force in contact
+    /// (every other tolerance the rotor's); within the budget with its tolerance neighbours
+    /// within it too, with a margin of two on the worst case (first and maximum contact force
+    /// and peak heat power within 0.1 % of `reference`, whirl frequency within 1 %, the same
+    /// class away from a transition; docs/accuracy.md#fidelity-presets).
     Standard,
     /// DOPRI5 at rtol 1e-9: the reference of the accuracy and convergence studies (DOP853 at
     /// rtol 1e-10 confirms it to 6e-6).

@@ -31,12 +31,12 @@
 //! [`ode`]: by default (the `standard` fidelity) RODAS4 then BDF ([`ode::Rodas4Bdf`]): the
 //! Rosenbrock method RODAS4 on the model's full Jacobian after every mode switch, and the
 //! variable-order BDF once the contact has run smoothly (the `draft` fidelity's too); RODAS4
-//! alone (the `draft` fidelity's until 2026-11-29), the BDF alone, the Rosenbrock-W method ROS34PW2, Rodas5P, RADAU5,
-//! Dormand-Prince 5(4) (the `reference` fidelity) and DOP853, all with dense output; contact
-//! onset and loss, support release, slip reversal and stick break-away are guard crossings
-//! located on the interpolant; the step is bounded in free flight; force and power peaks are
-//! located on the interpolant by the [`monitor::Monitor`] observer. Errors are typed and
-//! carry the time ([`SolveError`]).
+//! alone (the `draft` fidelity's until 2026-11-29), the BDF alone, the Rosenbrock-W method
+//! ROS34PW2, Rodas5P, RADAU5, Dormand-Prince 5(4) (the `reference` fidelity) and DOP853, all
+//! with dense output; contact onset and loss, support release, slip reversal and stick
+//! break-away are guard crossings located on the interpolant; the step is bounded in free
+//! flight; force and power peaks are located on the interpolant by the [`monitor::Monitor`]
+//! observer. Errors are typed and carry the time ([`SolveError`]).
 //!
 //! ## Classification
 //! [`classify`](mod@classify): the orbit class is decided on the final window of the run

@@ -55,8 +55,8 @@ pub enum Method {
     /// the full Jacobian, with a simplified Newton iteration (`ode/radau5.rs`).
     Radau5,
     /// BDF, the backward differentiation formulas of orders 1 to `bdf_max_order` (4 by
-    /// default, at most 5) with variable order and
-    /// quasi-constant step size (Shampine and Reichelt's scheme), on the full Jacobian with
+    /// default, at most 5) with variable order and quasi-constant step size (Shampine and
+    /// Reichelt's scheme), on the full Jacobian with
     /// Newton's iteration from the Jacobian at each step's prediction (`ode/bdf.rs`). Alone
     /// it restarts at order 1 after every mode switch.
     Bdf,
@@ -88,6 +88,12 @@ impl Method {
                 | Method::Rodas4Bdf
                 | Method::Rodas4Ndf
         )
+    }
+
+    /// Whether the stepper takes multistep (BDF or NDF) steps, whose highest order is
+    /// `solver.bdf_max_order`.
+    pub fn is_multistep(self) -> bool {
+        matches!(self, Method::Bdf | Method::Rodas4Bdf | Method::Rodas4Ndf)
     }
 }
 

@@ -172,9 +172,8 @@ impl<const N: usize> Rodas4Bdf<N> {
         {
             return;
         }
-        // SEED_ORDER + 1 values at RODAS4's next step size, or closer where the kept steps
-        // span less.
-        // (At most the BDF's highest order.)
+        // `order + 1` values (order SEED_ORDER, or the BDF's highest if lower) at RODAS4's
+        // next step size, or closer where the kept steps span less.
         let order = SEED_ORDER.min(self.bdf.max_order());
         let span = t - self.history[0].0;
         let h = self.rodas.core().h.min(span / order as f64);
