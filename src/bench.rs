@@ -73,7 +73,8 @@ struct Case {
 
 /// Runs the benchmark cases and prints a table: per case the fastest wall time of `reps` runs
 /// after a warm-up (on a shared machine every slower run was slowed by something else), its
-/// ratio to the baseline (the first row) and to the peer, and the work counts.
+/// ratio to the baseline (the first row) and to the peer, and the work counts. The runs go in
+/// rounds of every case once.
 pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
     let reps = a.reps;
     let cases: [Case; 19] = [
@@ -242,33 +243,47 @@ pub fn run(a: &BenchArgs) -> anyhow::Result<()> {
         "model/step"
     );
     // Every case's fastest time first, then the table (the estimate needs the DOPRI5 row).
-    let mut rows = Vec::new();
-    for c in &cases {
-        let mut scene = Scene::paper();
-        scene.speed_rpm = c.speed_rpm;
-        scene.mu_dynamic = c.mu;
-        (c.edit)(&mut scene);
-        let opts = DropOptions {
-            duration_s: 1.0,
-            ..Default::default()
-        };
-        let mut times = Vec::new();
-        let mut last = None;
-        // One run not counted: the first pays for cold caches and page faults.
-        let mut warm = EvalCount::default();
-        simulate_observed(&scene, &opts, &mut warm)?;
-        for _ in 0..reps {
+    // The repetitions run in rounds, each round every case once, so that a slow period of a
+    // shared machine (some seconds) falls on one round of every case, not on all the runs of
+    // one case: the ratios between rows then compare runs taken side by side.
+    let scenes: Vec<Scene> = cases
+        .iter()
+        .map(|c| {
+            let mut scene = Scene::paper();
+            scene.speed_rpm = c.speed_rpm;
+            scene.mu_dynamic = c.mu;
+            (c.edit)(&mut scene);
+            scene
+        })
+        .collect();
+    let opts = DropOptions {
+        duration_s: 1.0,
+        ..Default::default()
+    };
+    // One run per case not counted: the first pays for cold caches and page faults.
+    for scene in &scenes {
+        simulate_observed(scene, &opts, &mut EvalCount::default())?;
+    }
+    let mut times = vec![Vec::with_capacity(reps); cases.len()];
+    let mut last = Vec::with_capacity(cases.len());
+    for round in 0..reps {
+        for (i, scene) in scenes.iter().enumerate() {
             let mut count = EvalCount::default();
             let t = Instant::now();
-            let r = simulate_observed(&scene, &opts, &mut count)?;
-            times.push(t.elapsed().as_secs_f64() * 1e3);
-            last = Some((r, count.0));
+            let r = simulate_observed(scene, &opts, &mut count)?;
+            times[i].push(t.elapsed().as_secs_f64() * 1e3);
+            if round + 1 == reps {
+                last.push((r, count.0));
+            }
         }
-        let (r, evals) = last.expect("reps >= 1");
-        // The fastest run: on a shared machine every other run was slowed by something else.
+    }
+    // The fastest run of each case: on a shared machine every other run was slowed by
+    // something else.
+    let mut rows = Vec::with_capacity(cases.len());
+    for ((c, t), (r, evals)) in cases.iter().zip(&times).zip(last) {
         rows.push((
             c.name,
-            times.iter().copied().fold(f64::INFINITY, f64::min),
+            t.iter().copied().fold(f64::INFINITY, f64::min),
             r,
             evals,
         ));
