@@ -580,10 +580,37 @@ impl Scene {
         self.validate_fields()?;
         self.validate_consistency()?;
         if let Some(t) = &self.thermal {
-            t.validate_with(self.race_bore_radius_m(), self.pitch_diameter_m)?;
+            // The parameters against the geometry, and the heat network they make.
+            crate::thermal::ThermalModel::new(self, t)?;
         }
         if let Some(b) = &self.bearing {
             b.validate()?;
+            // The pair as the analysis runs it: a rating left at the default follows the
+            // geometry and material, and must be in its range too. The error says so, since
+            // the user did not write that number.
+            if let Some(run) = self.bearing_as_run() {
+                run.validate().map_err(|mut e| {
+                    if e.field.ends_with("_rating_n") {
+                        e.value = format!(
+                            "{} N, the ISO {} rating of this geometry and material (the \
+                             rating left at its default follows them)",
+                            approx(e.value.parse().unwrap_or(f64::NAN)),
+                            if e.field.contains("static") {
+                                "76"
+                            } else {
+                                "281"
+                            }
+                        );
+                        e.allowed = format!(
+                            "{}: set {} to the bearing's catalogue rating, or check the \
+                             geometry and material (bearing.young_modulus_pa, \
+                             bearing.ball_diameter_m, ...)",
+                            e.allowed, e.field
+                        );
+                    }
+                    e
+                })?;
+            }
             // One bearing: the one analysed is the one whose drag the dynamics use (eqs.
             // 11-13 take d_m); a journal larger than the analysed pitch circle went unseen.
             if b.pitch_diameter_m != self.pitch_diameter_m {
@@ -1036,6 +1063,27 @@ pub fn fnv1a64(bytes: &[u8]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_rating_that_follows_the_geometry_out_of_range_is_refused_by_validate() {
+        // Young's modulus at its lower end: each field in range, but the ISO 76 rating the
+        // default follows comes out past 1e8 N. Refused before any drop, and said to be derived.
+        let mut s = Scene::paper();
+        let b = crate::bearing::BearingPair {
+            young_modulus_pa: 1e9,
+            ..Default::default()
+        };
+        assert_eq!(b.validate(), Ok(()));
+        s.bearing = Some(b);
+        let e = s
+            .validate()
+            .expect_err("the derived static rating is out of range");
+        assert_eq!(e.field, "bearing.static_rating_n");
+        assert!(e.value.contains("ISO 76 rating of this geometry"), "{e}");
+        // A catalogue rating set by the user is the user's, and in range it passes.
+        s.bearing.as_mut().unwrap().static_rating_n = 20_000.0;
+        assert_eq!(s.validate(), Ok(()));
+    }
 
     #[test]
     fn the_methods_names_are_stable() {

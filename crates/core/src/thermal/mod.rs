@@ -50,7 +50,7 @@ pub struct ThermalModel {
 
 impl ThermalModel {
     /// Builds the model for `scene` with parameters `p`, checking them against the scene's
-    /// geometry.
+    /// geometry and the heat network they make ([`Network::check_rates`]).
     pub fn new(scene: &Scene, p: &ThermalParams) -> Result<Self, InvalidParameter> {
         p.validate_with(scene.race_bore_radius_m(), scene.pitch_diameter_m)?;
         let g = SceneGeometry {
@@ -61,8 +61,10 @@ impl ThermalModel {
         };
         let r_b = 0.5 * p.ball_diameter_m;
         let alpha0 = p.contact_angle_deg.to_radians();
+        let network = Network::paper(p, &g);
+        network.check_rates(p.macro_step_s)?;
         Ok(Self {
-            network: Network::paper(p, &g),
+            network,
             split: BearingHeatSplit::new(p.ball_diameter_m, alpha0, scene.pitch_diameter_m),
             expansion: Expansion {
                 xi_per_k: p.bearing_expansion_per_k,
@@ -227,6 +229,14 @@ impl ThermalRun {
     ) -> Result<Self, InvalidParameter> {
         let model = ThermalModel::new(scene, p)?;
         let step = ExactStep::new(&model.network, model.macro_step_s);
+        if !step.is_finite() {
+            // Not reached where `check_rates` passed; a last guard against NaN temperatures.
+            return Err(InvalidParameter::new(
+                "thermal network",
+                "a step matrix with infinite or NaN entries",
+                "parameters whose network the matrix exponential can step",
+            ));
+        }
         let macro_steps = (duration_s / model.macro_step_s).ceil();
         let stride = ((macro_steps / SERIES_POINTS as f64).ceil() as u64).max(1);
         let mut run = Self {

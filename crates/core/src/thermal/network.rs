@@ -32,6 +32,7 @@
 //!   Table 1's `n` in `R_Li`, `R_Le` is the ball count `z`.
 
 use super::params::ThermalParams;
+use crate::error::InvalidParameter;
 use std::f64::consts::PI;
 
 /// Node indices of the network.
@@ -64,6 +65,11 @@ pub mod node {
 
 /// Number of network nodes.
 pub const NODES: usize = 7;
+
+/// The largest rate times step [`Network::check_rates`] lets through: at the default
+/// parameters the fastest node's is about 0.02 (1 ms steps), so this leaves
+/// room for every bearing; the matrix exponential takes about `log2` of it squarings.
+pub const MAX_RATE_TIMES_STEP: f64 = 1e6;
 
 /// Table 1's thermal resistances (K/W) at a parameter set, plus the resolved `R_1`, `R_2`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -227,6 +233,57 @@ impl Network {
         q
     }
 
+    /// Checks that the network can be stepped exactly over `macro_step_s`: every heat
+    /// capacity positive and finite, every conductance finite and not negative, and at each
+    /// node the rate of its fastest exchange, its conductances over its capacity, times the
+    /// step at most [`MAX_RATE_TIMES_STEP`]; the error names the node that fails worst. Parameters inside their own ranges can still
+    /// combine past that (a lubricant film of almost no area, a housing of almost no
+    /// length): the matrix exponential then overflows, or never ends its squarings.
+    pub fn check_rates(&self, macro_step_s: f64) -> Result<(), InvalidParameter> {
+        let mut exchange_w_k = self.ambient_w_k;
+        for &(a, b, c) in &self.links {
+            exchange_w_k[a] += c;
+            exchange_w_k[b] += c;
+        }
+        let links_ok = self.links.iter().all(|l| l.2.is_finite() && l.2 >= 0.0)
+            && self.ambient_w_k.iter().all(|g| g.is_finite() && *g >= 0.0);
+        // The node that fails worst: NaN first, then the fastest.
+        let score = |k: usize| {
+            let cap = self.capacity_j_k[k];
+            let r = exchange_w_k[k] / cap;
+            if cap > 0.0 && cap.is_finite() && !r.is_nan() {
+                r
+            } else {
+                f64::INFINITY
+            }
+        };
+        let k = (0..NODES).fold(0, |w, k| if score(k) > score(w) { k } else { w });
+        {
+            let cap = self.capacity_j_k[k];
+            let rate_times_step = exchange_w_k[k] / cap * macro_step_s;
+            if !(links_ok && cap > 0.0 && cap.is_finite() && rate_times_step <= MAX_RATE_TIMES_STEP)
+            {
+                return Err(InvalidParameter::new(
+                    &format!("thermal network, node {}", node::NAMES[k]),
+                    format!(
+                        "{} J/K of heat capacity against {} W/K of conductance (its rate times \
+                         thermal.macro_step_s: {})",
+                        crate::scene::approx(cap),
+                        crate::scene::approx(exchange_w_k[k]),
+                        crate::scene::approx(rate_times_step)
+                    ),
+                    &format!(
+                        "a positive, finite heat capacity and a rate times the step <= \
+                         {MAX_RATE_TIMES_STEP:e}: a heat capacity (a mass, density or specific \
+                         heat) far too small, or a conductance (a conductivity, or a length or \
+                         film area near zero) far too large for a bearing"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// `G`: the conductance matrix (W/K), symmetric, ambient links on the diagonal.
     pub fn conductance_matrix(&self) -> [[f64; NODES]; NODES] {
         let mut g = [[0.0; NODES]; NODES];
@@ -312,6 +369,14 @@ impl ExactStep {
         }
     }
 
+    /// Whether every entry of the step's matrices is finite.
+    pub fn is_finite(&self) -> bool {
+        self.phi
+            .iter()
+            .chain(self.gamma.iter())
+            .all(|x| x.is_finite())
+    }
+
     /// Advances temperature rises `dt_k` and the ambient loss `lost_j` over the step with
     /// constant heat input `q_w`.
     pub fn advance(&self, dt_k: &mut [f64; NODES], lost_j: &mut f64, q_w: &[f64; NODES]) {
@@ -321,5 +386,72 @@ impl ExactStep {
         let out = self.phi * x + self.gamma * SVector::<f64, NODES>::from_column_slice(q_w);
         dt_k.copy_from_slice(&out.as_slice()[..NODES]);
         *lost_j = out[NODES];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::thermal::ThermalModel;
+    use crate::Scene;
+
+    /// The largest rate times step over the nodes of `scene`'s network.
+    fn fastest(scene: &Scene) -> f64 {
+        let p = scene.thermal.clone().expect("a thermal scene");
+        let m = ThermalModel::new(scene, &p).expect("a valid network");
+        let g = m.network.conductance_matrix();
+        (0..NODES)
+            .map(|k| g[k][k] / m.network.capacity_j_k[k] * m.macro_step_s)
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn the_default_network_is_far_inside_the_rate_limit() {
+        let mut scene = Scene::paper();
+        scene.thermal = Some(ThermalParams::default());
+        let r = fastest(&scene);
+        eprintln!("default fastest rate x step: {r:e}");
+        assert!(r > 0.0 && r < 1e-3 * MAX_RATE_TIMES_STEP, "{r:e}");
+    }
+
+    #[test]
+    fn a_network_too_fast_to_step_is_refused_before_any_drop() {
+        // Each within its field's range, each a network whose matrix exponential overflowed
+        // (NaN temperatures) or never ended its squarings before the check.
+        type Edit = fn(&mut ThermalParams);
+        let cases: [(&str, Edit, &str); 3] = [
+            (
+                "lubricant",
+                |p| p.lubricant_mass_kg = 1e-45,
+                "outer_lubricant",
+            ),
+            ("housing", |p| p.housing_length_m = 1e-12, "housing"),
+            (
+                "outer race",
+                |p| p.outer_race_mass_kg = 1e-300,
+                "outer_race",
+            ),
+        ];
+        for (what, edit, node) in cases {
+            let mut p = ThermalParams::default();
+            edit(&mut p);
+            assert_eq!(p.validate(), Ok(()), "{what}: inside the field ranges");
+            let mut scene = Scene::paper();
+            scene.thermal = Some(p);
+            let e = scene.validate().expect_err(what);
+            assert_eq!(
+                e.field,
+                format!("thermal network, node {node}"),
+                "{what}: {e}"
+            );
+            assert!(e.allowed.contains("rate times the step <= 1e6"), "{e}");
+        }
+        // Far past the default but a real bearing: a film of lubricant of a milligram.
+        let mut scene = Scene::paper();
+        scene.thermal = Some(ThermalParams {
+            lubricant_mass_kg: 1e-6,
+            ..Default::default()
+        });
+        assert_eq!(scene.validate(), Ok(()));
     }
 }

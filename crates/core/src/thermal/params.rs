@@ -186,54 +186,72 @@ impl ThermalParams {
             } else {
                 Err(InvalidParameter::new(
                     &format!("thermal.{field}"),
-                    v,
+                    crate::scene::num(v),
                     allowed,
                 ))
             }
         }
-        let pos = "> 0 and finite";
         let conv = "[0, 1e5] W/(m^2 K)";
-        let positive = [
-            ("rotor_conductivity_w_m_k", self.rotor_conductivity_w_m_k),
+        // Upper ends well beyond any material or bearing (diamond conducts about 2e3 W/(m K),
+        // hydrogen stores 1.4e4 J/(kg K), osmium weighs 2.3e4 kg/m^3): a value past them is
+        // a typing or unit slip, and would make the heat network's rates overflow.
+        let conductivity = (1e4, "(0, 1e4] W/(m K)");
+        let specific_heat = (1e5, "(0, 1e5] J/(kg K)");
+        let density = (1e5, "(0, 1e5] kg/m^3");
+        let length = (10.0, "(0, 10] m");
+        let mass = (1e6, "(0, 1e6] kg");
+        let bounded = [
+            (
+                "rotor_conductivity_w_m_k",
+                self.rotor_conductivity_w_m_k,
+                conductivity,
+            ),
             (
                 "rotor_specific_heat_j_kg_k",
                 self.rotor_specific_heat_j_kg_k,
+                specific_heat,
             ),
-            ("rotor_density_kg_m3", self.rotor_density_kg_m3),
+            ("rotor_density_kg_m3", self.rotor_density_kg_m3, density),
             (
                 "bearing_conductivity_w_m_k",
                 self.bearing_conductivity_w_m_k,
+                conductivity,
             ),
             (
                 "bearing_specific_heat_j_kg_k",
                 self.bearing_specific_heat_j_kg_k,
+                specific_heat,
             ),
-            ("bearing_density_kg_m3", self.bearing_density_kg_m3),
-            ("bearing_width_m", self.bearing_width_m),
-            ("ball_diameter_m", self.ball_diameter_m),
-            ("outer_race_mass_kg", self.outer_race_mass_kg),
+            ("bearing_density_kg_m3", self.bearing_density_kg_m3, density),
+            ("bearing_width_m", self.bearing_width_m, length),
+            ("ball_diameter_m", self.ball_diameter_m, length),
+            ("outer_race_mass_kg", self.outer_race_mass_kg, mass),
             (
                 "lubricant_conductivity_w_m_k",
                 self.lubricant_conductivity_w_m_k,
+                conductivity,
             ),
             (
                 "lubricant_specific_heat_j_kg_k",
                 self.lubricant_specific_heat_j_kg_k,
+                specific_heat,
             ),
-            ("lubricant_mass_kg", self.lubricant_mass_kg),
-            ("housing_length_m", self.housing_length_m),
+            ("lubricant_mass_kg", self.lubricant_mass_kg, mass),
+            ("housing_length_m", self.housing_length_m, length),
             (
                 "housing_conductivity_w_m_k",
                 self.housing_conductivity_w_m_k,
+                conductivity,
             ),
             (
                 "housing_specific_heat_j_kg_k",
                 self.housing_specific_heat_j_kg_k,
+                specific_heat,
             ),
-            ("housing_density_kg_m3", self.housing_density_kg_m3),
+            ("housing_density_kg_m3", self.housing_density_kg_m3, density),
         ];
-        for (name, v) in positive {
-            check(name, v, v > 0.0, pos)?;
+        for (name, v, (max, allowed)) in bounded {
+            check(name, v, v > 0.0 && v <= max, allowed)?;
         }
         check(
             "macro_step_s",
@@ -293,13 +311,16 @@ impl ThermalParams {
             self.housing_outer_radius_m,
             self.housing_outer_radius_m > 0.5 * self.outer_diameter_m
                 && self.housing_outer_radius_m <= 10.0,
-            "(outer_diameter_m / 2, 10] m",
+            &format!(
+                "(outer_diameter_m / 2, 10] m = ({}, 10] m",
+                crate::scene::approx(0.5 * self.outer_diameter_m)
+            ),
         )?;
         check(
             "outer_diameter_m",
             self.outer_diameter_m,
             self.outer_diameter_m > 0.0,
-            pos,
+            "> 0 and finite (and below 2 * housing_outer_radius_m)",
         )?;
         for (name, v) in [
             ("rub_heat_to_rotor", self.rub_heat_to_rotor),
