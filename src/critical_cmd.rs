@@ -15,7 +15,7 @@
 //! the rows are those of an uninterrupted run (each is a function of its drops' classes).
 
 use crate::{build_scene, flags, CmdResult, Done, Failure};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 use whirlmap_core::InvalidParameter;
 use whirlmap_sweep::critical::undecided_summary;
@@ -162,6 +162,14 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
         })?;
     }
     if let Some(p) = &a.csv {
+        if let Some(log) = a.log.as_deref().filter(|l| same_file(p, l)) {
+            return Err(Failure::Input(anyhow::anyhow!(
+                "--csv {} is the --log file {}: the CSV would replace the drop log (the record \
+                 of every drop classified); give the CSV another path",
+                p.display(),
+                log.display()
+            )));
+        }
         crate::check_writable(p).map_err(Failure::Output)?;
     }
 
@@ -222,6 +230,15 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
     let undecided = report_undecided(&rows);
     let unconfirmed = report_unconfirmed(&rows);
     Ok(Done::flagged_if(undecided || unconfirmed))
+}
+
+/// Whether two paths name the same file: the same file on disk when both exist (through
+/// links and `..` too), else the same path as written.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
 }
 
 /// Says on standard error which rows' onsets do not hold at the re-check at the next tighter

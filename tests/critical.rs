@@ -662,6 +662,25 @@ fn a_kept_drop_log_resumes_a_killed_search_and_answers_a_rerun() {
     assert!(fooled.status.success(), "{}", stderr(&fooled));
     assert!(fooled.stdout != full.stdout, "the marked line was not used");
 
+    // The CSV written to the log's own path (also as another spelling of it): refused
+    // before any drop, the log untouched.
+    for csv in [
+        full_log.clone(),
+        dir.join("sub").join("..").join("full.jsonl"),
+    ] {
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        let mut args = search(&full_log, "1");
+        args.extend(["--csv".to_string(), s(&csv).to_string()]);
+        let clash = whirlmap(&args);
+        assert_eq!(clash.status.code(), Some(2), "{}", stderr(&clash));
+        assert!(
+            stderr(&clash).contains("would replace the drop log"),
+            "{}",
+            stderr(&clash)
+        );
+        assert_eq!(std::fs::read(&full_log).unwrap(), before);
+    }
+
     // Another drop length: nothing to reuse.
     let other = whirlmap(&search(&full_log, "0.5"));
     assert!(other.status.success(), "{}", stderr(&other));
