@@ -272,11 +272,20 @@ fn critical(
     if let Some(f) = preset {
         f.apply(&mut base);
     }
+    // Each friction coefficient's scene, at the scene's speed and at the lowest speed
+    // searched (a stop speed, say, must lie below every release speed), as the command line
+    // checks them.
     for &mu in &mus {
         let mut s = base.clone();
         s.mu_dynamic = mu;
         s.validate()
             .map_err(|e| value_error(format!("with mu {mu}: {e}")))?;
+        s.speed_rpm = from_rpm;
+        s.validate().map_err(|e| {
+            value_error(format!(
+                "with mu {mu} at the lowest speed searched, from_rpm = {from_rpm}: {e}"
+            ))
+        })?;
     }
     let pool = pool(threads)?;
     let cancel = Cancel::new();
@@ -332,7 +341,9 @@ fn sweep(
         (None, Some(p)) => spec::read(&p).map_err(spec_error)?,
         (None, None) => return Err(value_error("a sweep spec (text or path) is required")),
     };
-    spec.check_points().map_err(value_error)?;
+    // Checking every point of a large grid takes seconds: without the GIL, so that the
+    // caller's other threads run meanwhile.
+    py.detach(|| spec.check_points()).map_err(value_error)?;
     let grid = spec.grid().map_err(value_error)?;
     let pool = pool(threads)?;
     let cancel = Cancel::new();

@@ -290,6 +290,13 @@ def test_a_preset_warns_of_the_overrides_it_replaces() -> None:
 
 
 def test_critical_checks_before_running() -> None:
+    # A stop speed above the lowest speed searched: refused there, before any drop.
+    with pytest.raises(ValueError, match=r"lowest speed searched, from_rpm = 2000.*stop_speed_rpm"):
+        whirlmap.critical(0.4, from_rpm=2000, to_rpm=4000, stop_speed_rpm=3000)
+    # The keys the search sets, also spelled with spaces around them.
+    for key in (" speed_rpm", "mu_dynamic "):
+        with pytest.raises(ValueError, match="allowed no value here"):
+            whirlmap.critical(0.5, from_rpm=2000, to_rpm=3000, **{key: 0.3})
     with pytest.raises(ValueError, match="to_rpm"):
         whirlmap.critical(0.4, from_rpm=5000, to_rpm=4000)
     with pytest.raises(ValueError, match="mu"):
@@ -379,6 +386,35 @@ def test_non_finite_values_are_refused_with_their_place() -> None:
         whirlmap.drop(8000, 0.3, release_offset_m=[float("nan"), 0.0])
     with pytest.raises(ValueError, match=r"invalid spec\.scene\.clearance_m = nan"):
         whirlmap.sweep({**SPEC, "scene": {"clearance_m": float("nan")}})
+
+
+def test_numbers_of_every_kind_and_non_numbers() -> None:
+    # NumPy's wider floats are numbers (their item() is themselves): no endless recursion.
+    wide = whirlmap.drop(8000, 0.3, duration_s=0.01, series=False, clearance_m=np.longdouble(2e-4))
+    assert wide.scene["clearance_m"] == 2e-4
+    whirlmap.drop(
+        8000, 0.3, duration_s=0.01, series=False,
+        release_offset_m=np.array([1e-5, 0.0], dtype=np.longdouble),
+    )  # fmt: skip
+    # Not numbers: strings (even of digits), bytes, complex numbers, an int past a double.
+    for bad in ("8000", b"8000", 8000 + 5j, np.complex128(8000)):
+        with pytest.raises(ValueError, match=r"invalid speed_rpm = .*: allowed a number"):
+            whirlmap.drop(bad, 0.3, duration_s=0.01)
+    with pytest.raises(ValueError, match=r"invalid duration_s = 1000.*within a double's range"):
+        whirlmap.drop(8000, 0.3, duration_s=10**400)
+    with pytest.raises(TypeError, match=r"invalid clearance_m = .*0\.0002\+0j.*: allowed numbers"):
+        whirlmap.drop(8000, 0.3, duration_s=0.01, clearance_m=np.complex128(2e-4))
+
+
+def test_parameters_that_combine_past_what_can_run_are_refused_first() -> None:
+    # Each in its range; together a heat network too fast to step, or a derived bearing
+    # rating out of range: ValueErrors naming them, before any drop.
+    with pytest.raises(ValueError, match=r"thermal network, node outer_lubricant"):
+        whirlmap.drop(8000, 0.3, duration_s=0.05, thermal={"lubricant_mass_kg": 1e-45})
+    with pytest.raises(ValueError, match=r"thermal.housing_length_m = 1e-30|node housing"):
+        whirlmap.drop(8000, 0.3, duration_s=0.05, thermal={"housing_length_m": 1e-30})
+    with pytest.raises(ValueError, match=r"bearing.static_rating_n = .*ISO 76 rating"):
+        whirlmap.drop(8000, 0.3, duration_s=0.05, bearing={"young_modulus_pa": 1e9})
 
 
 def test_options_are_checked_by_name() -> None:

@@ -89,9 +89,15 @@ class DropResult:
 
 
 def _json_default(value: Any) -> Any:
-    """JSON for NumPy scalars and arrays (``np.float64(0.3)``, ``np.array([0, 1e-5])``)."""
-    if isinstance(value, np.generic):
-        return value.item()
+    """JSON for NumPy scalars and arrays (``np.float64(0.3)``, ``np.array([0, 1e-5])``).
+    A real scalar of any width becomes a Python number (``np.longdouble`` too, whose
+    ``item()`` is itself); a complex one, or any other object, is no JSON value."""
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
     if isinstance(value, np.ndarray):
         return value.tolist()
     raise TypeError(f"not a JSON value: {value!r}")
@@ -124,7 +130,19 @@ def _json(value: Any, what: str) -> str:
         path, bad = found
         place = f"{what}.{path}" if path and not path.startswith("[") else f"{what}{path}"
         raise ValueError(f"invalid {place} = {bad}: allowed a finite number")
-    return json.dumps(value, default=_json_default, allow_nan=False)
+    try:
+        return json.dumps(value, default=_json_default, allow_nan=False)
+    except TypeError as e:
+        raise TypeError(
+            f"invalid {what} = {value!r}: allowed numbers, strings, booleans, None, lists and"
+            f" dicts of them, and NumPy real numbers and arrays ({e})"
+        ) from None
+
+
+def _dotted(key: str) -> str:
+    """An override's keyword as the scene key it names: ``solver__rtol`` is ``solver.rtol``;
+    spaces around it are dropped, as the engine drops them."""
+    return key.replace("__", ".").strip()
 
 
 def _overrides(overrides: Mapping[str, Any]) -> List[Tuple[str, str]]:
@@ -133,7 +151,7 @@ def _overrides(overrides: Mapping[str, Any]) -> List[Tuple[str, str]]:
     field's range; one inside a list or dict is refused here, naming its place."""
     pairs = []
     for key, value in overrides.items():
-        dotted = key.replace("__", ".")
+        dotted = _dotted(key)
         if isinstance(value, np.ndarray) and value.ndim == 0:
             value = value.item()
         if isinstance(value, (float, np.floating)) and not np.isfinite(value):
@@ -166,14 +184,24 @@ def _fidelity(fidelity: Optional[str]) -> Optional[str]:
 
 def _number(value: Any, name: str) -> float:
     """``value`` as a float, or a ``ValueError`` naming ``name``: a string, ``None``, a
-    boolean or an array of more than one number is no number here (the engine checks the
-    range)."""
-    if isinstance(value, (bool, np.bool_)) or np.ndim(value) != 0:
+    boolean, a complex number, an integer past a double's range or an array of more than one
+    number is no number here (the engine checks the range)."""
+    if (
+        isinstance(value, (bool, np.bool_, str, bytes, complex, np.complexfloating))
+        or np.ndim(value) != 0
+    ):
         raise ValueError(f"invalid {name} = {value!r}: allowed a number")
     try:
-        return float(value)
+        number = float(value)
     except (TypeError, ValueError):
         raise ValueError(f"invalid {name} = {value!r}: allowed a number") from None
+    except OverflowError:
+        # A Python int past a double's range: the engine's own message would say which
+        # range, but the number cannot reach it.
+        raise ValueError(
+            f"invalid {name} = {value!r}: allowed a number within a double's range (|x| < 1.8e308)"
+        ) from None
+    return number
 
 
 def _warn_preset_overrides(fidelity: Optional[str], overrides: Dict[str, Any]) -> None:
@@ -184,7 +212,7 @@ def _warn_preset_overrides(fidelity: Optional[str], overrides: Dict[str, Any]) -
     if fidelity is None:
         return
     for key, value in overrides.items():
-        dotted = key.replace("__", ".")
+        dotted = _dotted(key)
         if dotted in _whirlmap.PRESET_KEYS:
             warnings.warn(
                 f"fidelity={fidelity!r} sets the numerics, so {key}={value!r} has no effect"
@@ -383,11 +411,12 @@ def critical(
         raise ValueError(f"invalid mu = {mu!r}: allowed a number or a list of numbers")
     # The search sets the speed and the friction coefficient of every drop itself.
     for key, by in (("speed_rpm", "from_rpm and to_rpm"), ("mu_dynamic", "mu")):
-        if key in overrides:
-            raise ValueError(
-                f"invalid {key} = {overrides[key]!r}: allowed no value here, {by} set it "
-                "for every drop of the search"
-            )
+        for given, value in overrides.items():
+            if _dotted(given) == key:
+                raise ValueError(
+                    f"invalid {key} = {value!r}: allowed no value here, {by} set it "
+                    "for every drop of the search"
+                )
     _warn_preset_overrides(fidelity, overrides)
     text = _whirlmap.critical(
         mus,
