@@ -74,6 +74,11 @@ fn bad_specs_exit_2_name_the_field_and_run_nothing() {
         ),
         ("unknown chart", format!("{{{base}, \"charts\": [\"pie\"]}}"), &["charts", "pie"]),
         (
+            "a chart named twice",
+            format!("{{{base}, \"charts\": [\"classes\", \"max_force\", \"classes\"]}}"),
+            &["charts = classes: allowed each chart named once"],
+        ),
+        (
             "unknown axis",
             r#"{"name": "bad", "duration_s": 0.05, "axes": {"clearence_m": [1e-4]}}"#.into(),
             &["axes.clearence_m", "clearance_m"],

@@ -63,8 +63,10 @@ fn walk(given: &Value, shape: &Value, path: &str) -> Result<(), String> {
 /// Parses `text` as a `T`, then refuses a list wherever `T` has a struct
 /// ([`check_objects`]). A field's error names the field by its dotted path before serde's
 /// message, which keeps its line and column: `` `solver.rtol`: invalid type: string "x",
-/// expected f64 at line 1 column 23 ``.
+/// expected f64 at line 1 column 23 ``. A leading byte-order mark (which some Windows
+/// editors write) is skipped, as JSON readers may (RFC 8259, section 8.1).
 pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, serde_json::Error> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut de = serde_json::Deserializer::from_str(text);
     let parsed: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         // A whole file that is a list (`[]`) fails inside serde as a struct read by position
@@ -115,6 +117,15 @@ pub fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Erro
 mod tests {
     use super::*;
     use crate::Scene;
+
+    #[test]
+    fn a_byte_order_mark_is_skipped_and_columns_count_from_the_text() {
+        let s: Scene = from_str("\u{feff}{\"speed_rpm\": 4000}").unwrap();
+        assert_eq!(s.speed_rpm, 4000.0);
+        let with = from_str::<Scene>("\u{feff}{\"speed_rpm\": \"x\"}").unwrap_err();
+        let without = from_str::<Scene>("{\"speed_rpm\": \"x\"}").unwrap_err();
+        assert_eq!(with.to_string(), without.to_string());
+    }
 
     #[test]
     fn a_file_that_is_a_list_is_said_to_be_one() {

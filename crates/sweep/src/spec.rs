@@ -866,11 +866,19 @@ impl SweepSpec {
                 source: Box::new(err),
             })?;
         }
-        for c in &self.charts {
+        for (i, c) in self.charts.iter().enumerate() {
             if !CHART_NAMES.contains(&c.as_str()) {
                 return Err(SpecError::UnknownChart {
                     name: c.clone(),
                     known: CHART_NAMES.join(", "),
+                });
+            }
+            // As an axis's values: a name twice is a slip (the chart is drawn once).
+            if self.charts[..i].contains(c) {
+                return Err(SpecError::Invalid {
+                    field: "charts".into(),
+                    value: c.clone(),
+                    allowed: "each chart named once".into(),
                 });
             }
             // The grid charts are maps over release speed and friction: without both axes

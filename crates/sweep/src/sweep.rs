@@ -320,13 +320,27 @@ impl Existing {
     }
 }
 
+/// The records of an existing `points.jsonl` ([`read_existing`]): key -> latest record, and
+/// the numbers (1-based) of the complete lines that are no record (edited or damaged).
+struct ExistingRecords {
+    map: HashMap<String, Existing>,
+    unreadable_lines: Vec<usize>,
+}
+
 /// Reads `path`, drops a torn last line (truncating the file back to the last complete
-/// line) and returns key -> latest record. Lines that do not parse are ignored.
-fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
+/// line) and returns key -> latest record. Complete lines that are no record are left out
+/// and listed (their points run again).
+fn read_existing(path: &Path) -> Result<ExistingRecords, SweepError> {
     let mut map = HashMap::new();
+    let mut unreadable_lines = Vec::new();
     let mut file = match OpenOptions::new().read(true).write(true).open(path) {
         Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(map),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(ExistingRecords {
+                map,
+                unreadable_lines,
+            })
+        }
         Err(e) => return Err(io_err(path)(e)),
     };
     let mut bytes = Vec::new();
@@ -336,14 +350,19 @@ fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
         file.set_len(complete as u64).map_err(io_err(path))?;
         file.sync_all().map_err(io_err(path))?;
     }
-    for line in bytes[..complete].split(|b| *b == b'\n') {
-        let Ok(text) = std::str::from_utf8(line) else {
+    for (n, line) in bytes[..complete].split(|b| *b == b'\n').enumerate() {
+        if line.iter().all(u8::is_ascii_whitespace) {
             continue;
-        };
-        let Ok(p) = serde_json::from_str::<PointLine>(text) else {
+        }
+        let parsed = std::str::from_utf8(line)
+            .ok()
+            .and_then(|text| Some((text, serde_json::from_str::<PointLine>(text).ok()?)));
+        let Some((text, p)) = parsed else {
+            unreadable_lines.push(n + 1);
             continue;
         };
         let (Some(key), Some(_)) = (&p.key, &p.status) else {
+            unreadable_lines.push(n + 1);
             continue;
         };
         map.insert(
@@ -356,7 +375,10 @@ fn read_existing(path: &Path) -> Result<HashMap<String, Existing>, SweepError> {
             },
         );
     }
-    Ok(map)
+    Ok(ExistingRecords {
+        map,
+        unreadable_lines,
+    })
 }
 
 /// Writes `out/bearing.md` from the records ([`whirlmap_results::bearing_report`]) when the
@@ -775,7 +797,21 @@ pub fn run_grid(
     let timings_path = out.join(TIMINGS_FILE);
     let resume = opts.resume;
     let existing = if resume {
-        read_existing(&points_path)?
+        let read = read_existing(&points_path)?;
+        if !read.unreadable_lines.is_empty() {
+            let lines: Vec<String> = read
+                .unreadable_lines
+                .iter()
+                .map(|n| n.to_string())
+                .collect();
+            progress_line(&format!(
+                "warning: {}: line {} is no point record (edited or damaged?): left out, its \
+                 point runs again",
+                points_path.display(),
+                lines.join(", ")
+            ));
+        }
+        read.map
     } else {
         HashMap::new()
     };
@@ -1003,10 +1039,25 @@ mod tests {
             "{\"key\":\"a\",\"status\":\"ok\"}\n{\"key\":\"b\",\"status\":\"failed\"}\n{\"key\":\"b\",\"status\":\"ok\"}\n{\"key\":\"c\",\"sta",
         )
         .unwrap();
-        let m = read_existing(&p).unwrap();
+        let read = read_existing(&p).unwrap();
+        assert_eq!(
+            read.unreadable_lines,
+            Vec::<usize>::new(),
+            "a torn last line is no damage"
+        );
+        let m = read.map;
         assert_eq!(m.len(), 2);
         assert!(m["a"].ok && m["b"].ok, "the newer record wins");
         assert!(std::fs::read_to_string(&p).unwrap().ends_with("\"ok\"}\n"));
+        // A complete line that is no record, and one without a key: listed, the rest kept.
+        std::fs::write(
+            &p,
+            "{\"key\":\"a\",\"status\":\"ok\"}\ngarbage{{{\n\n{\"status\":\"ok\"}\n{\"key\":\"b\",\"status\":\"ok\"}\n",
+        )
+        .unwrap();
+        let read = read_existing(&p).unwrap();
+        assert_eq!(read.unreadable_lines, vec![2, 4]);
+        assert_eq!(read.map.len(), 2);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
