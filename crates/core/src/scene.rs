@@ -706,7 +706,10 @@ impl Scene {
             // Relative slack of 1e-12: 10 * 1e-6 rounds below 1e-5, which rejected a
             // user's exact "unbalance = 10 clearances" (found by the extremes matrix).
             self.unbalance_m >= 0.0 && self.unbalance_m <= 10.0 * self.clearance_m * (1.0 + 1e-12),
-            "[0, 10 * clearance_m] m",
+            &format!(
+                "[0, 10 * clearance_m] m = [0, {}] m",
+                approx(10.0 * self.clearance_m)
+            ),
         )?;
         check(
             "unbalance_phase_rad",
@@ -719,7 +722,10 @@ impl Scene {
             "release_offset_m",
             ox.hypot(oy),
             ox.hypot(oy) <= 0.9 * self.clearance_m,
-            "magnitude [0, 0.9 * clearance_m] m",
+            &format!(
+                "magnitude [0, 0.9 * clearance_m] m = [0, {}] m",
+                approx(0.9 * self.clearance_m)
+            ),
         )?;
         let [vx, vy] = self.release_velocity_m_s;
         check(
