@@ -233,6 +233,32 @@ pub const FIELD_RANGES: &[FieldRange] = &[
     ),
 ];
 
+/// The allowed range of the numeric scene field `key` (dotted) in words, as the scene check
+/// states it: `[3, 200]`, `(0, 1e4]`, `>= 1`; `None` for a key not in [`FIELD_RANGES`] or
+/// one with neither end.
+pub fn range_text(key: &str) -> Option<String> {
+    let r = FIELD_RANGES.iter().find(|r| r.key == key)?;
+    let n = |v: f64| crate::scene::num(v);
+    Some(match (r.min, r.max) {
+        (Some(lo), Some(hi)) => {
+            let (open, lo) = match lo {
+                Bound::Inclusive(v) => ('[', v),
+                Bound::Exclusive(v) => ('(', v),
+            };
+            let (close, hi) = match hi {
+                Bound::Inclusive(v) => (']', v),
+                Bound::Exclusive(v) => (')', v),
+            };
+            format!("{open}{}, {}{close}", n(lo), n(hi))
+        }
+        (Some(Bound::Inclusive(v)), None) => format!(">= {}", n(v)),
+        (Some(Bound::Exclusive(v)), None) => format!("> {}", n(v)),
+        (None, Some(Bound::Inclusive(v))) => format!("<= {}", n(v)),
+        (None, Some(Bound::Exclusive(v))) => format!("< {}", n(v)),
+        (None, None) => return None,
+    })
+}
+
 /// The unit of a field, read from its name's suffix (the project's naming rule: SI units,
 /// named where not obvious); `"1"` for a dimensionless number.
 pub fn unit_of(key: &str) -> &'static str {
@@ -525,6 +551,23 @@ mod tests {
                 None => {}
             }
         }
+    }
+
+    #[test]
+    fn ranges_in_words() {
+        assert_eq!(
+            range_text("thermal.ball_count").as_deref(),
+            Some("[3, 200]")
+        );
+        assert_eq!(
+            range_text("thermal.rotor_conductivity_w_m_k").as_deref(),
+            Some("(0, 1e4]")
+        );
+        assert_eq!(
+            range_text("solver.max_step_attempts").as_deref(),
+            Some(">= 1")
+        );
+        assert_eq!(range_text("no_such_key"), None);
     }
 
     #[test]

@@ -66,7 +66,7 @@ fn did_you_mean_text(suggestion: Option<&str>) -> String {
 /// `expected u64` `expected a whole number, 0 or more`, `expected a boolean` `expected true
 /// or false`); any other message is returned as it is.
 pub fn with_suggestion(message: &str) -> String {
-    let message = plain_types(message);
+    let message = with_range(&plain_types(message));
     const MARK: &str = "unknown field `";
     let Some(start) = message.find(MARK).map(|i| i + MARK.len()) else {
         return message;
@@ -91,6 +91,35 @@ pub fn with_suggestion(message: &str) -> String {
             &list[..at]
         ),
         None => format!("{head}{given}` (did you mean `{best}`?); {list}"),
+    }
+}
+
+/// A message about a scene field's value (`` `thermal.ball_count`: invalid value: integer
+/// `-3`, expected a whole number, 0 or more at line 1 column 27``) with the field's own
+/// allowed range added (`; allowed [3, 200]`): the type's range is wider than the field's.
+/// The path may start at the scene (a scene file) or above it (`scene.` in a sweep spec).
+fn with_range(message: &str) -> String {
+    let Some(rest) = message.strip_prefix('`') else {
+        return message.to_string();
+    };
+    let Some((path, tail)) = rest.split_once("`: ") else {
+        return message.to_string();
+    };
+    if !(tail.starts_with("invalid value") || tail.starts_with("invalid type")) {
+        return message.to_string();
+    }
+    let key = path.strip_prefix("scene.").unwrap_or(path);
+    match whirlmap_core::schema::range_text(key) {
+        Some(range) => {
+            let unit = whirlmap_core::schema::unit_of(key);
+            let unit = if unit == "1" {
+                String::new()
+            } else {
+                format!(" {unit}")
+            };
+            format!("{message}; allowed {range}{unit}")
+        }
+        None => message.to_string(),
     }
 }
 
@@ -578,6 +607,21 @@ mod tests {
             said.contains("expected a whole number, 0 or more"),
             "{said}"
         );
+        // ... and the field's own range, narrower than the type's, with its unit if any.
+        assert!(said.ends_with("; allowed >= 1"), "{said}");
+        let text = r#"{"solver": {"rtol": "x"}}"#;
+        let err = whirlmap_core::json::from_str::<Scene>(text).unwrap_err();
+        assert!(with_suggestion(&err.to_string()).ends_with("; allowed (0, 0.01]"));
+        let text = r#"{"thermal": {"bearing_width_m": "x"}}"#;
+        let err = whirlmap_core::json::from_str::<Scene>(text).unwrap_err();
+        assert!(with_suggestion(&err.to_string()).ends_with("; allowed (0, 10] m"));
+        // In a sweep spec the path starts above the scene; a key with no range is left.
+        assert!(
+            with_suggestion("`scene.thermal.ball_count`: invalid value: integer `-3`")
+                .ends_with("allowed [3, 200]")
+        );
+        let other = "`axes.mu.steps`: invalid value: integer `-2`, expected u64";
+        assert!(!with_suggestion(other).contains("allowed"));
     }
 
     #[test]
