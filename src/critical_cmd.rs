@@ -232,11 +232,23 @@ pub fn run(a: &CriticalArgs) -> CmdResult {
     Ok(Done::flagged_if(undecided || unconfirmed))
 }
 
-/// Whether two paths name the same file: the same file on disk when both exist (through
-/// links and `..` too), else the same path as written.
+/// Whether two paths name the same file, through links, `.` and `..`, whether the files
+/// exist yet or not (a first run's log does not).
 fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
+    /// The path with its folder resolved on disk, when the folder exists.
+    fn resolved(p: &Path) -> Option<PathBuf> {
+        if let Ok(full) = p.canonicalize() {
+            return Some(full);
+        }
+        let name = p.file_name()?;
+        let folder = match p.parent() {
+            Some(f) if !f.as_os_str().is_empty() => f,
+            _ => Path::new("."),
+        };
+        Some(folder.canonicalize().ok()?.join(name))
+    }
+    match (resolved(a), resolved(b)) {
+        (Some(x), Some(y)) => x == y,
         _ => a == b,
     }
 }

@@ -454,7 +454,9 @@ pub(crate) fn warn_spec_preset_overrides(path: &Path) {
     let Ok(text) = std::fs::read_to_string(path) else {
         return;
     };
-    let Ok(spec) = serde_json::from_str::<serde_json::Value>(&text) else {
+    let Ok(spec) =
+        serde_json::from_str::<serde_json::Value>(whirlmap_core::json::without_bom(&text))
+    else {
         return;
     };
     let preset = spec["fidelity"].as_str().unwrap_or_default();

@@ -680,6 +680,14 @@ fn a_kept_drop_log_resumes_a_killed_search_and_answers_a_rerun() {
         );
         assert_eq!(std::fs::read(&full_log).unwrap(), before);
     }
+    // A first run, the log not there yet, named two ways: refused, no file made.
+    let fresh = dir.join("fresh.jsonl");
+    let mut args = search(&fresh, "1");
+    let other_spelling = dir.join("sub").join("..").join("fresh.jsonl");
+    args.extend(["--csv".to_string(), s(&other_spelling).to_string()]);
+    let clash = whirlmap(&args);
+    assert_eq!(clash.status.code(), Some(2), "{}", stderr(&clash));
+    assert!(!fresh.exists());
 
     // Another drop length: nothing to reuse.
     let other = whirlmap(&search(&full_log, "0.5"));

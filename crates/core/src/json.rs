@@ -60,13 +60,19 @@ fn walk(given: &Value, shape: &Value, path: &str) -> Result<(), String> {
     }
 }
 
+/// `text` without a leading byte-order mark, which some Windows editors write before JSON
+/// (RFC 8259, section 8.1, lets a reader skip it).
+pub fn without_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
+}
+
 /// Parses `text` as a `T`, then refuses a list wherever `T` has a struct
 /// ([`check_objects`]). A field's error names the field by its dotted path before serde's
 /// message, which keeps its line and column: `` `solver.rtol`: invalid type: string "x",
 /// expected f64 at line 1 column 23 ``. A leading byte-order mark (which some Windows
 /// editors write) is skipped, as JSON readers may (RFC 8259, section 8.1).
 pub fn from_str<T: DeserializeOwned + Serialize>(text: &str) -> Result<T, serde_json::Error> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let text = without_bom(text);
     let mut de = serde_json::Deserializer::from_str(text);
     let parsed: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         // A whole file that is a list (`[]`) fails inside serde as a struct read by position

@@ -561,7 +561,7 @@ mod tests {
         );
         assert_eq!(
             range_text("thermal.rotor_conductivity_w_m_k").as_deref(),
-            Some("(0, 1e4]")
+            Some("(0, 10000]")
         );
         assert_eq!(
             range_text("solver.max_step_attempts").as_deref(),

@@ -374,7 +374,7 @@ fn sweep(
 /// not JSON (the sweep itself then says why).
 #[pyfunction]
 fn replaced_by_fidelity(text: &str) -> Vec<(String, String)> {
-    serde_json::from_str(text)
+    serde_json::from_str(whirlmap_core::json::without_bom(text))
         .map(|v| spec::replaced_by_fidelity(&v))
         .unwrap_or_default()
 }

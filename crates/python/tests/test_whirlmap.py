@@ -406,6 +406,18 @@ def test_numbers_of_every_kind_and_non_numbers() -> None:
         whirlmap.drop(8000, 0.3, duration_s=0.01, clearance_m=np.complex128(2e-4))
 
 
+def test_results_compare_by_identity_and_specs_by_kind() -> None:
+    a = whirlmap.drop(8000, 0.3, duration_s=0.01)
+    b = whirlmap.drop(8000, 0.3, duration_s=0.01)
+    assert a == a and a != b and len({a, b}) == 2
+    assert a.record == b.record
+    for bad in (None, 5, b"/tmp/spec.json"):
+        with pytest.raises(TypeError, match="invalid spec"):
+            whirlmap.sweep(bad)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="pass the spec as a dict"):
+        whirlmap.sweep('{"duration_s": 0.05, "axes": {"mu": [0.1]}}')
+
+
 def test_parameters_that_combine_past_what_can_run_are_refused_first() -> None:
     # Each in its range; together a heat network too fast to step, or a derived bearing
     # rating out of range: ValueErrors naming them, before any drop.

@@ -804,9 +804,14 @@ pub fn run_grid(
                 .iter()
                 .map(|n| n.to_string())
                 .collect();
+            let (noun, verb) = if lines.len() == 1 {
+                ("line", "is no point record")
+            } else {
+                ("lines", "are no point records")
+            };
             progress_line(&format!(
-                "warning: {}: line {} is no point record (edited or damaged?): left out, its \
-                 point runs again",
+                "warning: {}: {noun} {} {verb} (edited or damaged?): left out (a point with \
+                 no other record runs again)",
                 points_path.display(),
                 lines.join(", ")
             ));

@@ -19,7 +19,9 @@ use crate::error::InvalidParameter;
 use serde::{Deserialize, Serialize};
 
 /// The thermal model's parameters (paper Sec. 3, eqs. 18-31). A scene switches the thermal
-/// model on by carrying one of these (`"thermal": {}` takes every default).
+/// model on by carrying one of these (`"thermal": {}` takes every default). Beyond each
+/// field's range, the heat network they make with the scene must be one the exact step can
+/// take ([`crate::thermal::network::Network::check_rates`]).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -37,10 +39,13 @@ pub struct ThermalParams {
 
     // ---- rotor (shaft) node, eq. 19 ------------------------------------------------------
     /// Thermal conductivity of the rotor lambda_s (W/(m K)). Default 44.5, shaft steel \[ASM\].
+    /// Allowed (0, 1e4] W/(m K).
     pub rotor_conductivity_w_m_k: f64,
     /// Specific heat of the rotor C_ps (J/(kg K)). Default 475, steel \[ASM\].
+    /// Allowed (0, 1e5] J/(kg K).
     pub rotor_specific_heat_j_kg_k: f64,
     /// Density of the rotor (kg/m^3). Default 7850, steel \[ASM\].
+    /// Allowed (0, 1e5] kg/m^3.
     pub rotor_density_kg_m3: f64,
     /// Length L_s of the journal section lumped into the rotor node, also the conduction length
     /// of R_sac in Table 1 (m). Not in the paper: default 50 mm, about four bearing widths of
@@ -54,10 +59,13 @@ pub struct ThermalParams {
     // ---- bearing steel (races and balls), eqs. 20-24, 26-28 -------------------------------
     /// Conductivity of races and balls lambda_i = lambda_e = lambda_b (W/(m K)). Default 46.6,
     /// AISI 52100 \[ASM\].
+    /// Allowed (0, 1e4] W/(m K).
     pub bearing_conductivity_w_m_k: f64,
     /// Specific heat of races and balls (J/(kg K)). Default 475, AISI 52100 \[ASM\].
+    /// Allowed (0, 1e5] J/(kg K).
     pub bearing_specific_heat_j_kg_k: f64,
     /// Density of the balls (kg/m^3), for their mass. Default 7810, AISI 52100 \[ASM\].
+    /// Allowed (0, 1e5] kg/m^3.
     pub bearing_density_kg_m3: f64,
     /// Linear expansion coefficient xi of races and balls (1/K), eqs. 26-28. Default 11.9e-6,
     /// AISI 52100, 20-100 C \[ASM\].
@@ -69,11 +77,13 @@ pub struct ThermalParams {
     // ---- bearing geometry (Table 3 and catalogue) -----------------------------------------
     /// Bearing width W = B (m). Table 3: 12 mm. The network models one 71908, the bearing the
     /// dynamic model lumps (its race mass, Table 2's 0.048 kg, is one inner race).
+    /// Allowed (0, 10] m.
     pub bearing_width_m: f64,
     /// Outer diameter D of the outer race (m). Table 3: 62 mm; r_o = D/2.
     pub outer_diameter_m: f64,
     /// Ball diameter (m). Table 3: 5.5 mm; r_b = half of it. Raceway radii are
     /// r_i = d_m/2 - r_b and r_e = d_m/2 + r_b with d_m the scene's pitch diameter.
+    /// Allowed (0, 10] m (and inside the raceways).
     pub ball_diameter_m: f64,
     /// Number of balls z (Table 1's z and n). Not in the paper or the catalogue tables:
     /// default 22, the pitch circle (pi d_m = 160 mm) filled with 5.5 mm balls at the
@@ -82,6 +92,7 @@ pub struct ThermalParams {
     /// Outer race mass m_o (kg), eq. 24. Not in the paper: default 0.055 kg, the steel annulus
     /// between D = 62 mm and the raceway diameter over B (48 g) plus shoulders, in the
     /// proportion Table 2's inner race (0.048 kg) bears to its own annulus.
+    /// Allowed (0, 1e6] kg.
     pub outer_race_mass_kg: f64,
     /// Initial contact angle alpha_0 of eq. 29 (deg). Default 15, the 71908 CD \[SKF\].
     /// Allowed [0, 90).
@@ -90,11 +101,14 @@ pub struct ThermalParams {
     // ---- lubricant nodes, eqs. 21, 23 ------------------------------------------------------
     /// Lubricant conductivity lambda_l (W/(m K)). Default 0.145, mineral oil at 300 K
     /// [Incropera Table A.5].
+    /// Allowed (0, 1e4] W/(m K).
     pub lubricant_conductivity_w_m_k: f64,
     /// Lubricant specific heat C_pL (J/(kg K)). Default 1909 [Incropera Table A.5].
+    /// Allowed (0, 1e5] J/(kg K).
     pub lubricant_specific_heat_j_kg_k: f64,
     /// Lubricant mass of each lubricant node m_Li = m_Le (kg). Default 1 g: a 30 % grease
     /// fill \[SKF\] of the 71908's free space (about 7 cm^3), split between the two contacts.
+    /// Allowed (0, 1e6] kg.
     pub lubricant_mass_kg: f64,
     /// Convection coefficient h_l from the ball set and lubricant to the air (W/(m^2 K)),
     /// R_La in Table 1. Default 20 [Incropera Table 1.1]. Allowed [0, 1e5].
@@ -105,12 +119,16 @@ pub struct ThermalParams {
     /// around the 62 mm outer race. Allowed (r_o, 10].
     pub housing_outer_radius_m: f64,
     /// Housing length L_h (m). Default 24 mm: the two face-to-face 71908 of one location.
+    /// Allowed (0, 10] m.
     pub housing_length_m: f64,
     /// Housing conductivity lambda_h (W/(m K)). Default 44.5, steel \[ASM\].
+    /// Allowed (0, 1e4] W/(m K).
     pub housing_conductivity_w_m_k: f64,
     /// Housing specific heat C_ph (J/(kg K)). Default 475, steel \[ASM\].
+    /// Allowed (0, 1e5] J/(kg K).
     pub housing_specific_heat_j_kg_k: f64,
     /// Housing density (kg/m^3), for its mass. Default 7850, steel \[ASM\].
+    /// Allowed (0, 1e5] kg/m^3.
     pub housing_density_kg_m3: f64,
     /// Convection coefficient h_h of the housing surfaces (W/(m^2 K)), R_hav and R_hrv in
     /// Table 1. Default 10, free convection in air [Incropera Table 1.1]. Allowed [0, 1e5].

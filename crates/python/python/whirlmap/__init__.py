@@ -62,7 +62,7 @@ SERIES_NAMES: Tuple[str, ...] = (
 )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class DropResult:
     """One drop's outputs.
 
@@ -80,6 +80,9 @@ class DropResult:
             ``rotor_speed_rad_s``, ``race_speed_rad_s`` (rad/s).
         clearance_m: The radial clearance (m): the radius of the clearance circle.
         scene: The scene that ran, as a dict (the JSON of ``whirlmap scene``).
+
+    Results compare (``==``) and hash by identity: NumPy arrays have no single truth value,
+    so two drops are compared by their ``record`` dicts (equal for the same scene and build).
     """
 
     record: Dict[str, Any]
@@ -132,6 +135,11 @@ def _json(value: Any, what: str) -> str:
         raise ValueError(f"invalid {place} = {bad}: allowed a finite number")
     try:
         return json.dumps(value, default=_json_default, allow_nan=False)
+    except ValueError:
+        # A NumPy long double past a double's range, infinite once a float.
+        raise ValueError(
+            f"invalid {what} = {value!r}: allowed finite numbers within a double's range"
+        ) from None
     except TypeError as e:
         raise TypeError(
             f"invalid {what} = {value!r}: allowed numbers, strings, booleans, None, lists and"
@@ -238,7 +246,7 @@ def _warn_spec_preset_overrides(spec_text: str, where: str) -> None:
     ``fidelity`` preset replaces: the preset is applied after them, so they would otherwise
     vanish without a word. An axis is applied after the preset and may still set them."""
     replaced = _whirlmap.replaced_by_fidelity(spec_text)
-    preset = json.loads(spec_text).get("fidelity") if replaced else None
+    preset = json.loads(spec_text.lstrip("\ufeff")).get("fidelity") if replaced else None
     for key, value in replaced:
         warnings.warn(
             f"{where}: fidelity {preset} sets the numerics, so {key} = {value} has no effect"
@@ -512,9 +520,10 @@ def sweep(
 
     Raises:
         ValueError: The spec is invalid (the message names the field, the value and the
-            allowed range); nothing has run.
+            allowed range), or is a str of JSON text rather than a path; nothing has run.
         OSError: The spec file cannot be read (``FileNotFoundError`` when it does not
             exist, with its ``filename``); nothing has run.
+        TypeError: ``spec`` is neither a dict nor a path (``str`` or ``os.PathLike``).
         KeyboardInterrupt: Ctrl-C (or a notebook's "interrupt kernel") while the grid runs,
             when called from Python's main thread: the points not yet started are skipped,
             the running ones finish (at most a drop's time), and no record is returned; the
@@ -530,7 +539,19 @@ def sweep(
         _warn_spec_preset_overrides(spec_text, "the spec")
         text = _whirlmap.sweep(spec_text, None, _threads(threads))
     else:
+        if not isinstance(spec, (str, os.PathLike)) or isinstance(spec, bytes):
+            raise TypeError(
+                f"invalid spec = {spec!r}: allowed a dict (a sweep spec) or the path of a sweep"
+                " JSON file (str or os.PathLike)"
+            )
         path = os.fspath(spec)
+        if isinstance(path, bytes):
+            raise TypeError(f"invalid spec = {spec!r}: allowed a path as str, not bytes")
+        if path.lstrip().startswith("{"):
+            raise ValueError(
+                "invalid spec: a str is the path of a sweep JSON file, and this one is JSON"
+                " text; pass the spec as a dict (json.loads(text))"
+            )
         try:
             with open(path, encoding="utf-8") as f:
                 _warn_spec_preset_overrides(f.read(), path)
