@@ -436,8 +436,11 @@ def test_options_are_checked_by_name() -> None:
     for bad in (-5, 0, 2.7):
         with pytest.raises(ValueError, match="invalid series_points"):
             whirlmap.drop(8000, 0.3, duration_s=0.01, series_points=bad)
-    with pytest.raises(ValueError, match="invalid series"):
-        whirlmap.drop(8000, 0.3, duration_s=0.01, series="no")
+    for bad in ("no", 1.0, 1, np.array([1, 0])):
+        with pytest.raises(ValueError, match="invalid series"):
+            whirlmap.drop(8000, 0.3, duration_s=0.01, series=bad)
+    with pytest.raises(ValueError, match="invalid flat"):
+        whirlmap.sweep({"duration_s": 0.05, "axes": {"mu": [0.3]}}, flat=np.array([1, 0]))
     with pytest.raises(ValueError, match="invalid fidelity"):
         whirlmap.drop(8000, 0.3, duration_s=0.01, fidelity=1)
     with pytest.raises(ValueError, match="invalid speed_rpm = 1234"):

@@ -310,7 +310,8 @@ def drop(
         SimulationError: The solver failed (its kind and the simulated time are in the
             message).
     """
-    if series not in (True, False):
+    # Not `in (True, False)`: 1.0 equals True, and an array has no single truth value.
+    if not isinstance(series, (bool, np.bool_)):
         raise ValueError(f"invalid series = {series!r}: allowed True or False")
     whole = isinstance(series_points, (int, np.integer)) or (
         isinstance(series_points, (float, np.floating)) and float(series_points).is_integer()
@@ -530,7 +531,7 @@ def sweep(
             message says how many points had run. An exception another signal handler
             raises stops it the same way.
     """
-    if flat not in (True, False):
+    if not isinstance(flat, (bool, np.bool_)):
         raise ValueError(f"invalid flat = {flat!r}: allowed True or False")
     if isinstance(spec, Mapping):
         spec_dict = dict(spec)
