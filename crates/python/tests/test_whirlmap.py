@@ -127,6 +127,10 @@ def test_a_bad_value_names_the_field_value_and_range() -> None:
         whirlmap.drop("fast", 0.3)
     with pytest.raises(ValueError, match=r"invalid mu = 'abc': allowed a number"):
         whirlmap.critical("abc", from_rpm=3000, to_rpm=4000)
+    with pytest.raises(ValueError, match=r"invalid mu = \[0\.4, \[0\.5\]\]: allowed a number or a list"):
+        whirlmap.critical([0.4, [0.5]], from_rpm=3000, to_rpm=4000)
+    with pytest.raises(ValueError, match=r"invalid duration_s = .*: allowed a number"):
+        whirlmap.drop(8000, 0.3, duration_s=[1, [2]])
     with pytest.raises(ValueError, match=r"invalid flat = 'no': allowed True or False"):
         whirlmap.sweep({"duration_s": 0.05, "axes": {"mu": [0.3]}}, flat="no")
     # A call refused for a bad value does not also warn of an override the preset replaces.

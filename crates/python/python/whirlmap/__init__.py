@@ -194,9 +194,13 @@ def _number(value: Any, name: str) -> float:
     """``value`` as a float, or a ``ValueError`` naming ``name``: a string, ``None``, a
     boolean, a complex number, an integer past a double's range or an array of more than one
     number is no number here (the engine checks the range)."""
+    try:
+        ndim = np.ndim(value)
+    except ValueError:  # a ragged list: NumPy's own message would not name the field
+        ndim = -1
     if (
         isinstance(value, (bool, np.bool_, str, bytes, complex, np.complexfloating))
-        or np.ndim(value) != 0
+        or ndim != 0
     ):
         raise ValueError(f"invalid {name} = {value!r}: allowed a number")
     try:
@@ -412,9 +416,13 @@ def critical(
             for a re-check), and no row is returned; the message says how many drops had
             run. An exception another signal handler raises stops it the same way.
     """
-    if np.ndim(mu) == 0:
+    try:
+        mu_ndim = np.ndim(mu)
+    except ValueError:  # a ragged list: NumPy's own message would not name mu
+        mu_ndim = -1
+    if mu_ndim == 0:
         mus = [_number(mu, "mu")]
-    elif np.ndim(mu) == 1:
+    elif mu_ndim == 1:
         mus = [_number(m, "mu") for m in mu]  # type: ignore[union-attr]
     else:
         raise ValueError(f"invalid mu = {mu!r}: allowed a number or a list of numbers")
