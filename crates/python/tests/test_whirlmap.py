@@ -410,6 +410,16 @@ def test_numbers_of_every_kind_and_non_numbers() -> None:
         whirlmap.drop(8000, 0.3, duration_s=0.01, clearance_m=np.complex128(2e-4))
 
 
+def test_an_override_the_speed_or_mu_argument_replaces_is_warned_of() -> None:
+    with pytest.warns(RuntimeWarning, match=r"mu_dynamic=0\.5 has no effect: mu=0\.3"):
+        r = whirlmap.drop(8000, 0.3, duration_s=0.01, series=False, mu_dynamic=0.5)
+    assert r.scene["mu_dynamic"] == 0.3
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        r = whirlmap.drop(8000, None, duration_s=0.01, series=False, mu_dynamic=0.5)
+    assert r.scene["mu_dynamic"] == 0.5
+
+
 def test_results_compare_by_identity_and_specs_by_kind() -> None:
     a = whirlmap.drop(8000, 0.3, duration_s=0.01)
     b = whirlmap.drop(8000, 0.3, duration_s=0.01)

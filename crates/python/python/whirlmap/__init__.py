@@ -284,7 +284,8 @@ def drop(
     """Simulate one drop, as ``whirlmap drop`` does.
 
     The scene is the paper's, then each override in the order given, then ``speed_rpm``
-    and ``mu``; it is validated, then the fidelity preset is applied.
+    and ``mu`` (an override ``speed_rpm`` or ``mu_dynamic`` beside them has no effect: a
+    ``RuntimeWarning`` says so); it is validated, then the fidelity preset is applied.
 
     Args:
         speed_rpm: Rotor speed at release (r/min); ``None``: the scene's (8000).
@@ -336,6 +337,15 @@ def drop(
     )
     # After the drop: a call refused for a bad value says only that (a drop takes a second).
     _warn_preset_overrides(fidelity, overrides)
+    for key, arg, given in (("speed_rpm", "speed_rpm", speed_rpm), ("mu_dynamic", "mu", mu)):
+        for name, value in overrides.items():
+            if given is not None and _dotted(name) == key:
+                warnings.warn(
+                    f"{name}={value!r} has no effect: {arg}={given!r} is applied after the"
+                    " overrides",
+                    RuntimeWarning,
+                    stacklevel=2,
+                )
     return DropResult(
         record=json.loads(record),
         series=None if arrays is None else {k: arrays[k] for k in SERIES_NAMES},
