@@ -28,7 +28,7 @@ pub struct BenchArgs {
     reps: usize,
     /// Also run the long thermal scenes (`scenes/coast-down.json` to its stop speed and for
     /// 60 s, `scenes/runaway.json` for 60 s), each with the full model and with the `draft`
-    /// fidelity (RODAS4, race tolerance x1000, rtol 1e-4), and compare them (a few seconds of
+    /// fidelity (RODAS4 then BDF, race tolerance x1000, rtol 1e-4), and compare them (a few seconds of
     /// CPU in all).
     #[arg(long)]
     coast_down: bool,

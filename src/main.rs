@@ -611,9 +611,10 @@ fn print_summary(scene: &Scene, r: &DropReport, rec: &DropRecord, wall_s: f64) {
         String::new()
     };
     outln!(
-        "whirlmap drop: {:.0} r/min, mu_d {:.3}, {:.4} s simulated ({why}{extended})",
-        scene.speed_rpm,
-        scene.mu_dynamic,
+        "whirlmap drop: {} r/min, mu_d {}, {:.4} s simulated ({why}{extended})",
+        // The inputs as given (a search's 4390.625 r/min is not 4391).
+        whirlmap_core::scene::num(scene.speed_rpm),
+        whirlmap_core::scene::num(scene.mu_dynamic),
         r.end_time_s
     );
     outln!(
