@@ -14,7 +14,7 @@ use plotters::style::{register_font, FontStyle};
 pub const FONT_FAMILY: &str = "sans-serif";
 
 /// DejaVu Sans, regular. The only face embedded: other styles fall back to it.
-static DEJAVU_SANS: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+pub(crate) static DEJAVU_SANS: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 /// The embedded font bytes could not be parsed as a font.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

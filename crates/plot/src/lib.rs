@@ -42,6 +42,7 @@ pub mod peak_temperature;
 pub mod probability;
 pub mod render;
 pub mod render_all;
+pub mod text;
 pub mod thermal;
 
 pub use error::ChartError;

@@ -103,7 +103,8 @@ pub fn render<F: Figure>(path: &Path, size: (u32, u32), figure: &F) -> Result<()
     }
     let result = match format {
         ImageFormat::Png => {
-            let root = BitMapBackend::new(path, size).into_drawing_area();
+            let root = crate::text::GlyphTextBitMapBackend(BitMapBackend::new(path, size))
+                .into_drawing_area();
             let r = draw_and_present(&root, figure).map_err(|e| fail(&e));
             drop(root); // a failed present is retried (and ignored) on drop
             r
