@@ -590,16 +590,16 @@ impl Scene {
             // the user did not write that number.
             if let Some(run) = self.bearing_as_run() {
                 run.validate().map_err(|mut e| {
-                    if e.field.ends_with("_rating_n") {
+                    let derived = match e.field.as_str() {
+                        "bearing.static_rating_n" => Some(("76", run.static_rating_n)),
+                        "bearing.dynamic_rating_n" => Some(("281", run.dynamic_rating_n)),
+                        _ => None,
+                    };
+                    if let Some((iso, rating_n)) = derived {
                         e.value = format!(
-                            "{} N, the ISO {} rating of this geometry and material (the \
+                            "{} N, the ISO {iso} rating of this geometry and material (the \
                              rating left at its default follows them)",
-                            approx(e.value.parse().unwrap_or(f64::NAN)),
-                            if e.field.contains("static") {
-                                "76"
-                            } else {
-                                "281"
-                            }
+                            approx(rating_n)
                         );
                         e.allowed = format!(
                             "{}: set {} to the bearing's catalogue rating, or check the \

@@ -247,8 +247,9 @@ impl Network {
         }
         let links_ok = self.links.iter().all(|l| l.2.is_finite() && l.2 >= 0.0)
             && self.ambient_w_k.iter().all(|g| g.is_finite() && *g >= 0.0);
-        // The node that fails worst: NaN first, then the fastest.
-        let score = |k: usize| {
+        // Each node's rate, a capacity that is not positive and finite (or a NaN) counting
+        // as infinitely fast; the worst node is the one reported.
+        let rate = |k: usize| {
             let cap = self.capacity_j_k[k];
             let r = exchange_w_k[k] / cap;
             if cap > 0.0 && cap.is_finite() && !r.is_nan() {
@@ -257,29 +258,25 @@ impl Network {
                 f64::INFINITY
             }
         };
-        let k = (0..NODES).fold(0, |w, k| if score(k) > score(w) { k } else { w });
-        {
-            let cap = self.capacity_j_k[k];
-            let rate_times_step = exchange_w_k[k] / cap * macro_step_s;
-            if !(links_ok && cap > 0.0 && cap.is_finite() && rate_times_step <= MAX_RATE_TIMES_STEP)
-            {
-                return Err(InvalidParameter::new(
-                    &format!("thermal network, node {}", node::NAMES[k]),
-                    format!(
-                        "{} J/K of heat capacity against {} W/K of conductance (its rate times \
-                         thermal.macro_step_s: {})",
-                        crate::scene::approx(cap),
-                        crate::scene::approx(exchange_w_k[k]),
-                        crate::scene::approx(rate_times_step)
-                    ),
-                    &format!(
-                        "a positive, finite heat capacity and a rate times the step <= \
-                         {MAX_RATE_TIMES_STEP:e}: a heat capacity (a mass, density or specific \
-                         heat) far too small, or a conductance (a conductivity, or a length or \
-                         film area near zero) far too large for a bearing"
-                    ),
-                ));
-            }
+        let k = (0..NODES).fold(0, |w, k| if rate(k) > rate(w) { k } else { w });
+        let rate_times_step = rate(k) * macro_step_s;
+        if !(links_ok && rate_times_step <= MAX_RATE_TIMES_STEP) {
+            return Err(InvalidParameter::new(
+                &format!("thermal network, node {}", node::NAMES[k]),
+                format!(
+                    "{} J/K of heat capacity against {} W/K of conductance (its rate times \
+                     thermal.macro_step_s: {})",
+                    crate::scene::approx(self.capacity_j_k[k]),
+                    crate::scene::approx(exchange_w_k[k]),
+                    crate::scene::approx(rate_times_step)
+                ),
+                &format!(
+                    "a positive, finite heat capacity and a rate times the step <= \
+                     {MAX_RATE_TIMES_STEP:e}: a heat capacity (a mass, density or specific \
+                     heat) far too small, or a conductance (a conductivity, or a length or \
+                     film area near zero) far too large for a bearing"
+                ),
+            ));
         }
         Ok(())
     }

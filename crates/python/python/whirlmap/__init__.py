@@ -190,17 +190,22 @@ def _fidelity(fidelity: Optional[str]) -> Optional[str]:
     return fidelity
 
 
+def _ndim(value: Any) -> int:
+    """NumPy's number of dimensions of ``value``, or -1 for a ragged list (NumPy's own error
+    there would not name the argument)."""
+    try:
+        return int(np.ndim(value))
+    except ValueError:
+        return -1
+
+
 def _number(value: Any, name: str) -> float:
     """``value`` as a float, or a ``ValueError`` naming ``name``: a string, ``None``, a
     boolean, a complex number, an integer past a double's range or an array of more than one
     number is no number here (the engine checks the range)."""
-    try:
-        ndim = np.ndim(value)
-    except ValueError:  # a ragged list: NumPy's own message would not name the field
-        ndim = -1
     if (
         isinstance(value, (bool, np.bool_, str, bytes, complex, np.complexfloating))
-        or ndim != 0
+        or _ndim(value) != 0
     ):
         raise ValueError(f"invalid {name} = {value!r}: allowed a number")
     try:
@@ -426,10 +431,7 @@ def critical(
             for a re-check), and no row is returned; the message says how many drops had
             run. An exception another signal handler raises stops it the same way.
     """
-    try:
-        mu_ndim = np.ndim(mu)
-    except ValueError:  # a ragged list: NumPy's own message would not name mu
-        mu_ndim = -1
+    mu_ndim = _ndim(mu)
     if mu_ndim == 0:
         mus = [_number(mu, "mu")]
     elif mu_ndim == 1:
